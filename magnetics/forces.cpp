@@ -1,0 +1,51 @@
+// magnetics/forces.cpp — forces after the magnetizations have converged (Algorithm 1,
+// second half): one field + Jacobian evaluation, then a per-moment 3×3 formula.
+#include "magnetics/forces.hpp"
+
+#include "magnetics/curves.hpp"
+
+namespace magsim::mag {
+
+// eq. 4 (order of products derived, see header): F = μ0 V J [A (2M + H) + M]
+Vec3 zeeman_force(Curve curve, double V, double Ms, const Vec3& M, const Vec3& H, const Mat3& J) {
+  const Mat3 A = curve_dMdH(curve, H, Ms);
+  return kMu0 * V * (J * (A * (2.0 * M + H) + M));
+}
+
+// eqs. 3–4: E = −m·B = −μ0 V M·(M + H)
+double zeeman_energy(Curve curve, double V, double Ms, const Vec3& H) {
+  const Vec3 M = curve_M(curve, H, Ms);
+  return -kMu0 * V * M.dot(M + H);
+}
+
+// eq. 13: F = μ0 (m·∇)H; with ∇×H = 0 this is μ0 J m (eq. 14 written out)
+Vec3 classic_force(const Vec3& m, const Mat3& J) { return kMu0 * (J * m); }
+
+void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
+                    const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
+                    std::vector<Vec3>* tau, std::vector<Vec3>* F_classic) {
+  compute_fields(set, field, &ws->H, &ws->J, &ws->field);
+  const long n = static_cast<long>(set.size());
+  F->resize(n);
+  if (tau) tau->resize(n);
+  if (F_classic) F_classic->resize(n);
+#pragma omp parallel for schedule(static)
+  for (long j = 0; j < n; ++j) {
+    const Vec3& H = ws->H[j];
+    const Mat3& J = ws->J[j];
+    const Vec3 m = set.moment(j);
+    const Vec3 Fc = classic_force(m, J);
+    if (F_classic) (*F_classic)[j] = Fc;
+    if (set.kind[j] == MomentKind::Permanent) {
+      (*F)[j] = Fc;
+      if (tau) (*tau)[j] = kMu0 * m.cross(H);  // τ = μ0 m × H
+    } else {
+      (*F)[j] = model == ForceModel::Zeeman
+                    ? zeeman_force(curve, set.volume[j], set.Ms[j], set.M[j], H, J)
+                    : Fc;
+      if (tau) (*tau)[j] = Vec3::Zero();
+    }
+  }
+}
+
+}  // namespace magsim::mag

@@ -1,0 +1,55 @@
+// magnetics/moments.hpp — the moments of a magnetic system, structure of arrays.
+//
+// A moment j sits at world position p_j and stands for a volume V_j of material. It is
+// either induced (magnetization M_j computed from the field, saturation Ms_j, carried as two
+// sub-magnetizations M_j1, M_j2 with |M_jk| = Ms_j and M_j = (M_j1 + M_j2)/2, DESIGN §1.5)
+// or permanent (a fixed world-frame moment m_j, A·m²). Moments with the same group id
+// (≥ 0, usually a rigid body) exert no force on each other, but still magnetize each other.
+#pragma once
+
+#include "magnetics/types.hpp"
+
+#include <cstddef>
+#include <vector>
+
+namespace magsim::mag {
+
+struct MomentSet {
+  // description
+  std::vector<Vec3> position;       ///< (n) world position (m)
+  std::vector<double> volume;       ///< (n) volume the moment stands for (m³), > 0
+  std::vector<double> Ms;           ///< (n) saturation magnetization (A/m); 0 for permanent
+  std::vector<MomentKind> kind;     ///< (n)
+  std::vector<Vec3> m_perm;         ///< (n) world-frame permanent moment (A·m²); 0 for induced
+  std::vector<std::int32_t> group;  ///< (n) rigid-body id, −1 = a group of its own
+  Vec3 H0 = Vec3::Zero();           ///< uniform external field (A/m)
+
+  // state (induced moments; permanent moments keep M = m/V and M1 = M2 = 0)
+  std::vector<Vec3> M1, M2;  ///< (n) sub-magnetizations, |M_jk| = Ms_j (A/m)
+  std::vector<Vec3> M;       ///< (n) magnetization (A/m)
+  std::vector<std::uint8_t> seeded;  ///< (n) 0 until the sub-pair axis has been chosen
+
+  std::size_t size() const { return position.size(); }
+
+  /// Adds an unmagnetized induced moment (M = 0; its sub-pair axis is seeded on the first
+  /// dynamics iteration, perpendicular to the field it feels). Returns its index.
+  int add_induced(const Vec3& p, double V, double Ms_, std::int32_t grp = -1);
+  /// Adds a permanent moment m (A·m²) of volume V. Returns its index.
+  int add_permanent(const Vec3& p, double V, const Vec3& m, std::int32_t grp = -1);
+
+  /// The dipole moment m_j: V_j M_j for induced, m_perm_j for permanent (A·m²).
+  Vec3 moment(std::size_t j) const {
+    return kind[j] == MomentKind::Induced ? Vec3(volume[j] * M[j]) : m_perm[j];
+  }
+  /// Sets an induced moment's magnetization to M (|M| ≤ Ms) keeping the sub-pair axis
+  /// where possible: M_j1,2 = Ms (cos φ u ± sin φ w), cos φ = |M|/Ms.
+  void set_magnetization(std::size_t j, const Vec3& Mj);
+  /// Forgets every induced magnetization (M = 0, unseeded).
+  void reset_magnetization();
+  std::size_t induced_count() const;
+};
+
+/// A unit vector perpendicular to u (|u| > 0), chosen deterministically.
+Vec3 any_perpendicular(const Vec3& u);
+
+}  // namespace magsim::mag

@@ -1,0 +1,48 @@
+// magnetics/types.hpp — shared vocabulary of the magnetics core (Eigen only).
+// SI units throughout: metres, A/m for H and M, A·m² for moments, newtons, seconds.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace magsim::mag {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kMu0 = 4e-7 * kPi;  ///< vacuum permeability (T·m/A)
+
+enum class MomentKind : std::uint8_t { Induced, Permanent };
+
+/// Magnetization dynamics / solver. Exact is the Newton ground truth (no dynamics).
+enum class Method : std::uint8_t { Ours, OursRealigned, Kim2018, DampingLLG, Exact };
+
+/// Magnetization curve M = f(H).
+enum class Curve : std::uint8_t {
+  Tanh,  ///< ours, eq. 10: f(H) = Ms tanh(3|H|/Ms) H/|H|
+  Kim    ///< Kim 2018, eq. 7: M = H/γ_D below saturation, Ms H/|H| above (γ_D = 1/3)
+};
+
+/// Force model for induced moments.
+enum class ForceModel : std::uint8_t {
+  Zeeman,  ///< ours, eq. 4 (M varies with H)
+  Classic  ///< eqs. 13–14 (m held constant)
+};
+
+/// The curve a method converges to (Kim 2018 uses eq. 7, every other method eq. 10).
+inline Curve curve_of(Method m) { return m == Method::Kim2018 ? Curve::Kim : Curve::Tanh; }
+/// The force model a method is paired with (the paper's pairing).
+inline ForceModel force_model_of(Method m) {
+  return m == Method::Kim2018 ? ForceModel::Classic : ForceModel::Zeeman;
+}
+
+/// "ours", "ours-realigned", "kim2018", "damping-llg", "exact".
+const char* method_name(Method m);
+/// Parses a method name; returns false (and leaves *out alone) on an unknown name.
+bool parse_method(const std::string& name, Method* out);
+
+}  // namespace magsim::mag
