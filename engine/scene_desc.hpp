@@ -1,0 +1,96 @@
+// engine/scene_desc.hpp — a scene as plain data (STYLE.md §1): bodies, shapes, moments,
+// materials and run options, defaults in-class, SI units in comments. A SceneDesc compiles
+// into a read-only Model; everything that changes lives in State.
+#pragma once
+
+#include "magnetics/magnetization.hpp"
+#include "render/frame.hpp"
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+namespace magsim::engine {
+
+using Vec3 = Eigen::Vector3d;
+using Quat = Eigen::Quaterniond;
+
+enum class ShapeKind { Sphere, Box, Capsule, Cylinder };
+
+/// A collision + render primitive fixed to a body. Capsules/cylinders lie along local z.
+struct ShapeDesc {
+  ShapeKind kind = ShapeKind::Sphere;
+  Vec3 offset = Vec3::Zero();           ///< position in the body frame (m)
+  Quat rotation = Quat::Identity();     ///< orientation in the body frame
+  /// sphere {r,-,-}; box half extents {hx,hy,hz}; capsule/cylinder {r, half length,-} (m)
+  Vec3 size = Vec3(0.005, 0.005, 0.005);
+};
+
+/// A magnetic moment fixed to a body.
+struct MomentDesc {
+  Vec3 offset = Vec3::Zero();  ///< position in the body frame (m)
+  bool permanent = false;
+  double volume = 0.0;         ///< material volume the moment stands for (m³), > 0
+  double Ms = 1.6e6;           ///< induced: saturation magnetization (A/m); iron 1.6e6
+  Vec3 moment = Vec3::Zero();  ///< permanent: body-frame moment (A·m²)
+};
+
+enum class BodyType {
+  Dynamic,    ///< moved by forces and contacts
+  Kinematic,  ///< moved by its scripted velocity, not by forces (infinite mass in contacts)
+  Static      ///< never moves: a geom without a body
+};
+
+struct BodyDesc {
+  std::string name;
+  BodyType type = BodyType::Dynamic;
+  Vec3 position = Vec3::Zero();          ///< (m)
+  Quat orientation = Quat::Identity();
+  Vec3 velocity = Vec3::Zero();          ///< (m/s); kinematic: held constant
+  Vec3 angular_velocity = Vec3::Zero();  ///< (rad/s); kinematic: held constant
+  double density = 7870.0;               ///< (kg/m³) used when mass ≤ 0; iron 7870
+  double mass = 0.0;                     ///< (kg) if > 0 overrides density·volume
+  std::vector<ShapeDesc> shapes;
+  std::vector<MomentDesc> moments;
+  render::Color color{0.55f, 0.56f, 0.58f};
+  bool visible = true;                   ///< e.g. the invisible moment of alphabets
+  bool magnet = false;                   ///< counts as "the magnet" for attachment metrics
+};
+
+enum class SpaceKind { Hash, SweepAndPrune, Simple };
+
+/// Run options. Defaults are the engine's; each scene overrides what it needs.
+struct SimOptions {
+  mag::Method method = mag::Method::Ours;
+  mag::DynamicsOptions magnetics;  ///< Δt_m, β, tolerance, cap … (method is set from above)
+  double dt = 1e-3;                ///< rigid step Δt_r (s)
+  Vec3 gravity = Vec3(0, 0, -9.81);  ///< (m/s²)
+  bool ground = true;              ///< an infinite static plane z = 0
+  double friction = 0.5;           ///< Coulomb μ; 0 = frictionless contacts
+  double restitution = 0.0;        ///< bounce in [0, 1]
+  double erp = 0.2;                ///< ODE error reduction parameter
+  double cfm = 1e-9;               ///< ODE constraint force mixing
+  int quickstep_iterations = 20;
+  int max_contacts = 4;            ///< per geom pair
+  SpaceKind space = SpaceKind::Hash;
+  bool auto_disable = false;       ///< ODE auto-disable of resting bodies
+  double linear_damping = 0.0;     ///< velocity decay rate c (1/s): v ← v·e^{−cΔt} per step; 0 = none
+  double angular_damping = 0.0;    ///< the same for angular velocity (1/s)
+  double surface_layer = 0.0;      ///< ODE contact surface layer: resting penetration allowed (m)
+  /// cap on the velocity ODE uses to push penetrating bodies apart (m/s); 0 = unlimited
+  double max_correcting_velocity = 0.0;
+  int threads = 0;                 ///< OpenMP threads for magnetics (0 = all)
+};
+
+struct SceneDesc {
+  std::string name;
+  std::string description;      ///< one line: what the scene shows
+  std::string modelling_level;  ///< DESIGN §2: what is simplified (moments per body, shapes…)
+  std::vector<BodyDesc> bodies;
+  Vec3 H0 = Vec3::Zero();       ///< uniform external field (A/m)
+  SimOptions options;
+  render::Camera camera;        ///< framed on the action
+  double default_seconds = 2.0; ///< simulated time of a default run
+};
+
+}  // namespace magsim::engine

@@ -1,0 +1,337 @@
+// scenes/registry.cpp — the five scenes of DESIGN §3 as data. Sizes and strengths are ours
+// (the paper gives only counts); each is stated beside its value, in SI units.
+#include "scenes/registry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace magsim::scenes {
+
+using engine::BodyDesc;
+using engine::BodyType;
+using engine::MomentDesc;
+using engine::SceneDesc;
+using engine::ShapeDesc;
+using engine::ShapeKind;
+using engine::Vec3;
+using engine::Quat;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kIronMs = 1.6e6;        // saturation magnetization of iron (A/m)
+constexpr double kIronDensity = 7870.0;  // (kg/m³)
+constexpr double kNdFeBM = 1.0e6;        // magnetization of a neodymium magnet, Br ≈ 1.26 T (A/m)
+const render::Color kIron{0.55f, 0.56f, 0.58f};
+const render::Color kMagnetRed{0.80f, 0.12f, 0.12f};
+
+double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+
+/// An iron ball: one sphere, one induced moment at its centre (modelling level: 1 moment).
+BodyDesc iron_ball(const std::string& name, const Vec3& p, double r) {
+  BodyDesc b;
+  b.name = name;
+  b.position = p;
+  b.density = kIronDensity;
+  b.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(r, r, r)});
+  MomentDesc m;
+  m.volume = sphere_volume(r);
+  m.Ms = kIronMs;
+  b.moments.push_back(m);
+  b.color = kIron;
+  return b;
+}
+
+/// N balls of radius r stacked in square layers of side n, pitch 2r(1 + gap), bottom layer
+/// resting on z = 0 and centred on (cx, cy).
+void stack_balls(SceneDesc* s, int N, int side, double r, double gap, double cx, double cy,
+                 double z0 = 0.0) {
+  const double pitch = 2.0 * r * (1.0 + gap);
+  for (int k = 0; k < N; ++k) {
+    const int layer = k / (side * side), in = k % (side * side);
+    const int i = in % side, j = in / side;
+    const Vec3 p(cx + (i - 0.5 * (side - 1)) * pitch, cy + (j - 0.5 * (side - 1)) * pitch,
+                 z0 + r + layer * pitch);
+    s->bodies.push_back(iron_ball("ball_" + std::to_string(k), p, r));
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// balls_up — 243 iron balls (9×9×3, radius 5 mm) resting on frictionless ground; a 2 cm
+// neodymium cube magnet fixed 3 cm above the top layer pulls them up.
+SceneDesc balls_up(const SceneParams& p) {
+  SceneDesc s;
+  s.name = "balls_up";
+  s.description = "243 iron balls on frictionless ground pulled up by a fixed cube magnet";
+  s.modelling_level =
+      "1 induced moment per ball (sphere primitive); magnet: static box geom with 1 "
+      "permanent moment at its centre; no friction";
+  const int N = p.count > 0 ? p.count : 243;
+  const double r = 0.005;
+  stack_balls(&s, N, 9, r, 0.001, 0, 0);
+  const double L = 0.02;  // cube side (m)
+  BodyDesc mag;
+  mag.name = "magnet";
+  mag.type = BodyType::Static;
+  mag.magnet = true;
+  mag.position = Vec3(0, 0, 3 * 2 * r + 0.03 + L / 2);
+  mag.shapes.push_back({ShapeKind::Box, Vec3::Zero(), Quat::Identity(), Vec3(L / 2, L / 2, L / 2)});
+  MomentDesc m;
+  m.permanent = true;
+  m.volume = L * L * L;
+  m.moment = Vec3(0, 0, kNdFeBM * L * L * L * p.strength);  // 8 A·m², pointing up
+  mag.moments.push_back(m);
+  mag.color = kMagnetRed;
+  s.bodies.push_back(mag);
+  s.options.friction = 0.0;
+  s.camera.eye = Eigen::Vector3f(0.16f, -0.20f, 0.12f);
+  s.camera.target = Eigen::Vector3f(0.0f, 0.0f, 0.03f);
+  s.default_seconds = 3.0;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// alphabets — 100 letter pieces (iron, 3 cm tall, 5 mm strokes, 1 induced moment per
+// stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible 2000 A·m² moment at
+// the grid centre (|H| ≈ 4.6 Ms at the nearest letters) with an invisible 1.5 cm collider.
+struct Stroke {
+  double x0, y0, x1, y1;  // glyph units: width 2, height 3
+};
+const std::vector<std::vector<Stroke>>& glyphs() {
+  static const std::vector<std::vector<Stroke>> g = {
+      {{0.75, 0, 1.25, 3}},                                      // I
+      {{0, 0, 0.5, 3}, {0.5, 0, 2, 0.5}},                        // L
+      {{0.75, 0, 1.25, 2.5}, {0, 2.5, 2, 3}},                    // T
+      {{0, 0, 0.5, 3}, {1.5, 0, 2, 3}, {0.5, 1.25, 1.5, 1.75}},  // H
+      {{0, 0, 0.5, 3}, {0.5, 0, 2, 0.5}, {0.5, 1.25, 1.6, 1.75}, {0.5, 2.5, 2, 3}},  // E
+      {{0, 0, 0.5, 3}, {0.5, 1.25, 1.6, 1.75}, {0.5, 2.5, 2, 3}},                    // F
+      {{0, 0.5, 0.5, 3}, {1.5, 0.5, 2, 3}, {0, 0, 2, 0.5}},                          // U
+      {{1.5, 0.5, 2, 3}, {0, 0, 2, 0.5}, {0, 0.5, 0.5, 1.25}},                       // J
+  };
+  return g;
+}
+
+BodyDesc letter(int index, const Vec3& p, const Quat& q) {
+  const double unit = 0.01;    // glyph unit (m): letters 2 × 3 cm
+  const double depth = 0.005;  // (m)
+  const auto& strokes = glyphs()[index % glyphs().size()];
+  BodyDesc b;
+  b.name = "letter_" + std::to_string(index);
+  b.position = p;
+  b.orientation = q;
+  b.density = kIronDensity;
+  static const render::Color palette[] = {{0.85f, 0.35f, 0.2f}, {0.2f, 0.5f, 0.85f},
+                                          {0.95f, 0.75f, 0.2f}, {0.3f, 0.7f, 0.35f},
+                                          {0.6f, 0.35f, 0.75f}};
+  b.color = palette[index % 5];
+  for (const Stroke& st : strokes) {
+    const Vec3 c((0.5 * (st.x0 + st.x1) - 1.0) * unit, (0.5 * (st.y0 + st.y1) - 1.5) * unit, 0);
+    const Vec3 h(0.5 * (st.x1 - st.x0) * unit, 0.5 * (st.y1 - st.y0) * unit, 0.5 * depth);
+    b.shapes.push_back({ShapeKind::Box, c, Quat::Identity(), h});
+    MomentDesc m;
+    m.offset = c;
+    m.volume = 8.0 * h.x() * h.y() * h.z();
+    m.Ms = kIronMs;
+    b.moments.push_back(m);
+  }
+  return b;
+}
+
+SceneDesc alphabets(const SceneParams& p) {
+  SceneDesc s;
+  s.name = "alphabets";
+  s.description = "100 iron letters in mid-air gathered by an invisible, excessively strong moment";
+  s.modelling_level =
+      "letters = 1–4 boxes, 1 induced moment per box; central moment: static, invisible, "
+      "with an invisible sphere collider of 1.5 cm; no gravity, no ground";
+  const int N = p.count > 0 ? p.count : 100;
+  const double pitch = 0.07;
+  std::mt19937 rng(2018);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < N; ++k) {
+    const int i = k % 5, j = (k / 5) % 5, l = (k / 25) % 4, extra = k / 100;
+    const Vec3 pos((i - 2) * pitch, (j - 2) * pitch, (l - 1.5) * pitch + extra * 0.02);
+    const Quat q = Quat(Eigen::AngleAxisd(kPi * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
+    s.bodies.push_back(letter(k, pos, q));
+  }
+  BodyDesc c;
+  c.name = "centre";
+  c.type = BodyType::Static;
+  c.magnet = true;
+  c.visible = false;
+  c.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(0.015, 0.015, 0.015)});
+  MomentDesc m;
+  m.permanent = true;
+  m.volume = sphere_volume(0.015);
+  m.moment = Vec3(0, 0, 2000.0 * p.strength);
+  c.moments.push_back(m);
+  s.bodies.push_back(c);
+  s.options.gravity = Vec3::Zero();
+  s.options.ground = false;
+  s.camera.eye = Eigen::Vector3f(0.45f, -0.55f, 0.30f);
+  s.camera.target = Eigen::Vector3f(0, 0, 0);
+  s.default_seconds = 3.0;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// falling_magnet — 1032 iron balls (radius 5 mm) stacked 12×12 per layer; a heavy sphere
+// magnet (radius 2 cm, NdFeB, 33.5 A·m², 0.25 kg) falls onto them from 8 cm above the top.
+SceneDesc falling_magnet(const SceneParams& p) {
+  SceneDesc s;
+  s.name = "falling_magnet";
+  s.description = "a heavy sphere magnet falls onto 1032 stacked iron balls";
+  s.modelling_level =
+      "1 induced moment per ball; magnet: dynamic sphere with 1 permanent moment (torque on "
+      "it from the balls' field)";
+  const int N = p.count > 0 ? p.count : 1032;
+  const double r = 0.005;
+  stack_balls(&s, N, 12, r, 0.001, 0, 0);
+  const int layers = (N + 143) / 144;
+  const double top = layers * 2 * r * 1.001;
+  const double R = 0.02;
+  BodyDesc mag;
+  mag.name = "magnet";
+  mag.magnet = true;
+  mag.position = Vec3(0.004, -0.003, top + 0.08 + R);
+  mag.density = 7500.0;  // NdFeB (kg/m³)
+  mag.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(R, R, R)});
+  MomentDesc m;
+  m.permanent = true;
+  m.volume = sphere_volume(R);
+  m.moment = Vec3(0, 0, -kNdFeBM * sphere_volume(R) * p.strength);  // pointing down
+  mag.moments.push_back(m);
+  mag.color = kMagnetRed;
+  s.bodies.push_back(mag);
+  s.camera.eye = Eigen::Vector3f(0.26f, -0.32f, 0.22f);
+  s.camera.target = Eigen::Vector3f(0, 0, 0.03f);
+  s.default_seconds = 2.0;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// sakura_tree — 2500 iron balls (radius 4 mm) fall from a 50×50 grid 40 cm up onto a static
+// tree of capsules whose 8 branch ends each carry a 20 A·m² permanent moment.
+SceneDesc sakura_tree(const SceneParams& p) {
+  SceneDesc s;
+  s.name = "sakura_tree";
+  s.description = "2500 iron balls fall onto a tree whose branch ends are magnets";
+  s.modelling_level =
+      "1 induced moment per ball; tree: static capsules (trunk, 2 levels of branches), 1 "
+      "permanent moment at each of the 8 branch ends";
+  const int N = p.count > 0 ? p.count : 2500;
+  const double r = 0.004;
+  BodyDesc tree;
+  tree.name = "tree";
+  tree.type = BodyType::Static;
+  tree.magnet = true;
+  tree.color = {0.45f, 0.30f, 0.18f};
+  auto capsule = [&](const Vec3& a, const Vec3& b, double rad) {
+    const Vec3 d = b - a;
+    ShapeDesc sh;
+    sh.kind = ShapeKind::Capsule;
+    sh.offset = 0.5 * (a + b);
+    sh.rotation = Quat::FromTwoVectors(Vec3::UnitZ(), d.normalized());
+    sh.size = Vec3(rad, 0.5 * d.norm(), 0);
+    tree.shapes.push_back(sh);
+  };
+  const Vec3 base(0, 0, 0), fork(0, 0, 0.16);
+  capsule(base, fork, 0.012);
+  for (int i = 0; i < 4; ++i) {
+    const double a = kPi / 2 * i + 0.3;
+    const Vec3 mid = fork + Vec3(0.07 * std::cos(a), 0.07 * std::sin(a), 0.07);
+    capsule(fork, mid, 0.007);
+    for (int k = -1; k <= 1; k += 2) {
+      const double b = a + 0.45 * k;
+      const Vec3 tip = mid + Vec3(0.06 * std::cos(b), 0.06 * std::sin(b), 0.05);
+      capsule(mid, tip, 0.004);
+      MomentDesc m;
+      m.permanent = true;
+      m.volume = 1e-6;
+      m.offset = tip;
+      m.moment = 20.0 * p.strength * (tip - mid).normalized();
+      tree.moments.push_back(m);
+    }
+  }
+  s.bodies.push_back(tree);
+  const int side = static_cast<int>(std::ceil(std::sqrt(std::min(N, 2500))));
+  for (int k = 0; k < N; ++k) {
+    const int layer = k / (side * side), in = k % (side * side);
+    const int i = in % side, j = in / side;
+    const double pitch = 0.011;
+    const Vec3 pos((i - 0.5 * (side - 1)) * pitch + 0.0013 * (j % 3),
+                   (j - 0.5 * (side - 1)) * pitch, 0.40 + layer * 0.03);
+    s.bodies.push_back(iron_ball("ball_" + std::to_string(k), pos, r));
+  }
+  s.camera.eye = Eigen::Vector3f(0.55f, -0.65f, 0.45f);
+  s.camera.target = Eigen::Vector3f(0, 0, 0.17f);
+  s.default_seconds = 2.0;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// crystal_balls — 178 fixed iron balls (radius 5 mm) on a sphere of radius 5 cm (Fibonacci
+// lattice) around a 6 cm bar magnet of 3 permanent moments. strength 1 = the strong magnet
+// (4000 A·m² in all, |H| up to ≈ 4 Ms at the poles); the weak magnet is strength 0.05.
+SceneDesc crystal_balls(const SceneParams& p) {
+  SceneDesc s;
+  s.name = "crystal_balls";
+  s.description = "178 fixed iron balls around a bar magnet (paper Figs. 7–8)";
+  s.modelling_level =
+      "balls: static spheres with 1 induced moment each (fixed in space, only M moves); "
+      "bar magnet: static box with 3 permanent moments along its axis";
+  const int N = p.count > 0 ? p.count : 178;
+  const double r = 0.005, R = 0.05;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < N; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / N;
+    const double rho = std::sqrt(1.0 - z * z);
+    const Vec3 pos(R * rho * std::cos(golden * k), R * rho * std::sin(golden * k), R * z);
+    BodyDesc b = iron_ball("ball_" + std::to_string(k), pos + Vec3(0, 0, 0.1), r);
+    b.type = BodyType::Static;
+    s.bodies.push_back(b);
+  }
+  BodyDesc bar;
+  bar.name = "bar_magnet";
+  bar.type = BodyType::Static;
+  bar.magnet = true;
+  bar.position = Vec3(0, 0, 0.1);
+  bar.shapes.push_back({ShapeKind::Box, Vec3::Zero(), Quat::Identity(), Vec3(0.006, 0.006, 0.03)});
+  for (int k = -1; k <= 1; ++k) {
+    MomentDesc m;
+    m.permanent = true;
+    m.offset = Vec3(0, 0, 0.02 * k);
+    m.volume = 0.012 * 0.012 * 0.02;
+    m.moment = Vec3(0, 0, 4000.0 / 3.0 * p.strength);
+    bar.moments.push_back(m);
+  }
+  bar.color = kMagnetRed;
+  s.bodies.push_back(bar);
+  s.options.gravity = Vec3::Zero();
+  s.camera.eye = Eigen::Vector3f(0.12f, -0.16f, 0.16f);
+  s.camera.target = Eigen::Vector3f(0, 0, 0.1f);
+  s.default_seconds = 0.05;
+  return s;
+}
+
+}  // namespace
+
+const std::vector<SceneEntry>& registry() {
+  static const std::vector<SceneEntry> r = {
+      {"balls_up", "243 iron balls pulled up by a fixed cube magnet (paper Fig. 3)", balls_up},
+      {"alphabets", "100 iron letters gathered by an invisible strong moment (Fig. 4)", alphabets},
+      {"falling_magnet", "a heavy magnet falls onto 1032 iron balls (Fig. 5)", falling_magnet},
+      {"sakura_tree", "2500 iron balls fall onto a magnetic tree (Fig. 6)", sakura_tree},
+      {"crystal_balls", "178 fixed balls around a bar magnet (Figs. 7–8)", crystal_balls},
+  };
+  return r;
+}
+
+const SceneEntry* find_scene(const std::string& name) {
+  for (const SceneEntry& e : registry())
+    if (name == e.name) return &e;
+  return nullptr;
+}
+
+}  // namespace magsim::scenes

@@ -1,0 +1,18 @@
+// scenes/scene_file.hpp — scenes loaded from JSON files (schema in README.md), so a user
+// can make a new scene without recompiling.
+#pragma once
+
+#include "engine/scene_desc.hpp"
+
+#include <string>
+
+namespace magsim::scenes {
+
+/// Reads and validates a scene file. Throws std::runtime_error with a one-line message
+/// naming the file and the offending field (unreadable file, malformed JSON, unknown key,
+/// missing or non-finite value, negative size/volume/mass, unknown enum).
+engine::SceneDesc load_scene_file(const std::string& path);
+/// The same from a JSON text (`origin` names it in messages).
+engine::SceneDesc parse_scene_json(const std::string& text, const std::string& origin);
+
+}  // namespace magsim::scenes

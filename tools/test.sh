@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# tools/test.sh — builds the test suite and runs it with CTest.
+#
+#   bash tools/test.sh            Release build in build/release, every test
+#   bash tools/test.sh --asan     ASan+UBSan build in build/asan (renderer off)
+#   bash tools/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability)
+# Installs the Debian packages first if any is missing (tools/setup.sh --deps-only).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+preset=release
+ctest_args=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --asan) preset=asan ;;
+    --) shift; ctest_args=("$@"); break ;;
+    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "test.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+bash tools/setup.sh --deps-only
+if [ "$preset" = asan ]; then
+  cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMAGSIM_SANITIZE=ON \
+        -DMAGSIM_RENDER=OFF >/dev/null
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+  export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+else
+  cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
+fi
+cmake --build "build/$preset" -j"$(nproc)"
+ctest --test-dir "build/$preset" --output-on-failure -j"$(nproc)" "${ctest_args[@]}"
