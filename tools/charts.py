@@ -1,0 +1,234 @@
+#!/usr/bin/python3
+"""tools/charts.py — draws the report's charts from the CSV/JSON the experiment programs
+write (Debian's python3-matplotlib; no other dependency).
+
+    /usr/bin/python3 tools/charts.py OUT_DIR    reads OUT_DIR/*.csv|json, writes OUT_DIR/*.png
+
+Every chart is skipped (with a note) when its data file is missing, so a partial run still
+draws what it has."""
+import csv
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.colors import LogNorm  # noqa: E402
+
+COLORS = {"ours": "tab:blue", "ours-realigned": "tab:green", "kim2018": "tab:red",
+          "damping-llg": "tab:orange", "anderson": "tab:purple", "exact": "black"}
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def have(out, name):
+    p = os.path.join(out, name)
+    if not os.path.exists(p):
+        print(f"charts: {name} missing, chart skipped")
+        return None
+    return p
+
+
+def fig8(out):
+    p = have(out, "fig8.csv")
+    if not p:
+        return
+    data = defaultdict(lambda: ([], []))
+    for r in rows(p):
+        k = (r["magnet"], r["method"])
+        data[k][0].append(int(r["iteration"]))
+        data[k][1].append(max(float(r["e_M"]), 1e-16))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
+    for ax, magnet in zip(axes, ["weak", "strong"]):
+        for (mg, method), (x, y) in sorted(data.items()):
+            if mg == magnet:
+                ax.semilogy(x, y, label=method, color=COLORS.get(method))
+        ax.set_title(f"crystal_balls, {magnet} bar magnet (paper Fig. 8)")
+        ax.set_xlabel("iteration")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("e_M (eq. 12)")
+    axes[1].legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "fig8.png"), dpi=110)
+    plt.close(fig)
+
+
+def fig9(out):
+    order = list(COLORS)
+    files = sorted((f for f in os.listdir(out) if f.startswith("fig9_") and f.endswith(".csv")
+                    and "shard" not in f),
+                   key=lambda f: order.index(f[5:-4]) if f[5:-4] in order else len(order))
+    if not files:
+        print("charts: fig9_*.csv missing, chart skipped")
+        return
+    fig, axes = plt.subplots(1, len(files), figsize=(4.2 * len(files), 4.5), squeeze=False)
+    for ax, f in zip(axes[0], files):
+        method = f[len("fig9_"):-4]
+        rs = rows(os.path.join(out, f))
+        dts = sorted({float(r["dt_mult"]) for r in rs})
+        hs = sorted({float(r["h_mult"]) for r in rs})
+        grid = [[math.nan] * len(dts) for _ in hs]
+        for r in rs:
+            grid[hs.index(float(r["h_mult"]))][dts.index(float(r["dt_mult"]))] = \
+                float(r["mean_iterations"])
+        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="rainbow",
+                       norm=LogNorm(vmin=1, vmax=999),
+                       extent=[dts[0], dts[-1], hs[0], hs[-1]])
+        ax.set_title(method)
+        ax.set_xlabel("Δt / 100 ns")
+        ax.set_ylabel("|H| / |M|")
+    fig.colorbar(im, ax=axes[0].tolist(), label="mean iterations (red: ≥ 999 / failure)")
+    fig.suptitle("Stability map (paper Fig. 9)")
+    fig.savefig(os.path.join(out, "fig9.png"), dpi=110)
+    plt.close(fig)
+
+
+def fig10(out):
+    p = have(out, "fig10.csv")
+    if not p:
+        return
+    rs = rows(p)
+    xs = sorted({float(r["x"]) for r in rs})
+    zs = sorted({float(r["z"]) for r in rs})
+    grids = {}
+    for key in ("F_kim", "F_ours"):
+        g = [[math.nan] * len(xs) for _ in zs]
+        for r in rs:
+            g[zs.index(float(r["z"]))][xs.index(float(r["x"]))] = float(r[key])
+        grids[key] = g
+    vals = [v for g in grids.values() for row in g for v in row if not math.isnan(v) and v > 0]
+    norm = LogNorm(vmin=min(vals), vmax=max(vals))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+    for ax, key, title in zip(axes, ("F_kim", "F_ours"),
+                              ("Kim 2018: classic force, eq. 7 curve", "ours: Zeeman force (eq. 4)")):
+        im = ax.imshow(grids[key], origin="lower", cmap="rainbow", norm=norm,
+                       extent=[xs[0] * 100, xs[-1] * 100, zs[0] * 100, zs[-1] * 100])
+        ax.set_title(title)
+        ax.set_xlabel("x (cm)")
+        ax.set_ylabel("z (cm)")
+    fig.colorbar(im, ax=axes.tolist(), label="|F| on a 2 mm iron ball (N), one scale")
+    fig.suptitle("Force near a uniformly magnetized sphere (paper Fig. 10)")
+    fig.savefig(os.path.join(out, "fig10.png"), dpi=110)
+    plt.close(fig)
+
+
+def speed(out):
+    p = have(out, "speed_accuracy.csv")
+    if p:
+        data = defaultdict(lambda: ([], []))
+        for r in rows(p):
+            k = (r["magnet"], r["method"])
+            data[k][0].append(float(r["wall_ms"]))
+            data[k][1].append(max(float(r["e_M"]), 1e-16))
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
+        for ax, magnet in zip(axes, ["weak", "strong"]):
+            for (mg, method), (x, y) in sorted(data.items()):
+                if mg != magnet:
+                    continue
+                style = "o-" if method == "exact" else "-"
+                ax.loglog(x, y, style, label=method if method != "exact" else "Newton (exact)",
+                          color=COLORS.get(method))
+            ax.set_title(f"speed against accuracy, crystal_balls {magnet}")
+            ax.set_xlabel("wall time (ms)")
+            ax.grid(True, which="both", alpha=0.3)
+        axes[0].set_ylabel("e_M")
+        axes[1].legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "speed_accuracy.png"), dpi=110)
+        plt.close(fig)
+    p = have(out, "dt_iterations.csv")
+    if p:
+        data = defaultdict(lambda: ([], []))
+        for r in rows(p):
+            it = int(r["iterations_to_1e-4"])
+            data[(r["magnet"], r["method"])][0].append(float(r["dt_ns"]))
+            data[(r["magnet"], r["method"])][1].append(it if it > 0 else float("nan"))
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
+        for ax, magnet in zip(axes, ["weak", "strong"]):
+            for (mg, method), (x, y) in sorted(data.items()):
+                if mg == magnet:
+                    ax.plot(x, y, "o-", label=method, color=COLORS.get(method))
+            ax.set_title(f"Δt_m against iterations to e_M ≤ 1e-4 ({magnet}); gaps: never")
+            ax.set_xlabel("Δt_m (ns)")
+            ax.set_yscale("log")
+            ax.grid(True, which="both", alpha=0.3)
+        axes[0].set_ylabel("iterations")
+        axes[1].legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "dt_iterations.png"), dpi=110)
+        plt.close(fig)
+
+
+def bench(out):
+    p = have(out, "bench.json")
+    if not p:
+        return
+    with open(p) as f:
+        b = json.load(f)
+    runs = b.get("runs", [])
+    scenes = sorted({r["scene"] for r in runs})
+    methods = sorted({r["method"] for r in runs})
+    if not runs:
+        return
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    width = 0.8 / max(1, len(methods))
+    for mi, m in enumerate(methods):
+        for si, s in enumerate(scenes):
+            r = next((r for r in runs if r["scene"] == s and r["method"] == m), None)
+            if not r:
+                continue
+            t = r["timing_ms"]
+            bottom = 0
+            for key, hatch in (("T_i", ""), ("T_f", "//"), ("T_r", "..")):
+                v = t[key]["median"]
+                ax.bar(si + mi * width, v, width, bottom=bottom, color=COLORS.get(m),
+                       hatch=hatch, edgecolor="black", linewidth=0.3,
+                       label=f"{m} {key}" if si == 0 else None)
+                bottom += v
+    ax.set_xticks([i + 0.4 - width / 2 for i in range(len(scenes))])
+    ax.set_xticklabels(scenes)
+    ax.set_ylabel("ms per 1 ms step (median)")
+    ax.set_yscale("log")
+    ax.set_title("Table 1: T_i (plain), T_f (//), T_r (..) per step")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "table1.png"), dpi=110)
+    plt.close(fig)
+    sc = b.get("scaling", [])
+    if sc:
+        fig, ax = plt.subplots(figsize=(6, 4.5))
+        for m in sorted({r["method"] for r in sc}):
+            pts = sorted((r["balls"], r["total_ms"]) for r in sc if r["method"] == m)
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=m, color=COLORS.get(m))
+        ax.set_xlabel("balls")
+        ax.set_ylabel("ms per step (median, T_i + T_f + T_r)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        ax.set_title("Scaling (sakura_tree with N balls)")
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "scaling.png"), dpi=110)
+        plt.close(fig)
+
+
+def main():
+    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        sys.exit(0 if len(sys.argv) == 2 else 2)
+    out = sys.argv[1]
+    if not os.path.isdir(out):
+        print(f"charts: {out} is not a directory", file=sys.stderr)
+        sys.exit(2)
+    for f in (fig8, fig9, fig10, speed, bench):
+        f(out)
+    print(f"charts: written to {out}")
+
+
+if __name__ == "__main__":
+    main()
