@@ -4,12 +4,14 @@
 //   impostor quads: 0 corner (vec2), 1 centre + radius (vec4, per instance), 2 colour (vec3)
 //   meshes:         0 position (vec3), 1 normal (vec3), per instance 2 position (vec3),
 //                   3 orientation quaternion xyzw (vec4), 4 scale (vec3), 5 colour (vec3)
-//   ground:         0 corner (vec2)
+//   ground:         0 world x, y (vec2)
 #pragma once
 
 namespace magsim::render::shaders {
 
 extern const char* const kSphereVert;
+extern const char* const kSphereLib;  ///< prepended to the two sphere fragment shaders
+extern const char* const kSphereDepthFrag;
 extern const char* const kSphereFrag;
 extern const char* const kSphereShadowVert;
 extern const char* const kSphereShadowFrag;
@@ -19,9 +21,11 @@ extern const char* const kMeshShadowVert;
 extern const char* const kDepthOnlyFrag;
 extern const char* const kGroundVert;
 extern const char* const kGroundFrag;
-/// Lighting and shadow lookup. The colour-pass fragment shaders (kSphereFrag, kMeshFrag,
-/// kGroundFrag) carry no #version line: they are compiled as
-/// "#version 330 core" + kLightingLib + body.
+/// Lighting and shadow lookup for the colour-pass fragment shaders.
 extern const char* const kLightingLib;
+/// material_metal(colour) for the colour-pass vertex shaders.
+extern const char* const kMaterialLib;
+// None of the sources carries a #version line: the renderer compiles
+// "#version 330 core" + defines + the library (if any) + the body.
 
 }  // namespace magsim::render::shaders
