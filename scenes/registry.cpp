@@ -85,6 +85,7 @@ SceneDesc balls_up(const SceneParams& p) {
   mag.color = kMagnetRed;
   s.bodies.push_back(mag);
   s.options.friction = 0.0;
+  s.options.quickstep_iterations = 100;
   s.camera.eye = Eigen::Vector3f(0.16f, -0.20f, 0.12f);
   s.camera.target = Eigen::Vector3f(0.0f, 0.0f, 0.03f);
   s.default_seconds = 3.0;
@@ -93,8 +94,10 @@ SceneDesc balls_up(const SceneParams& p) {
 
 // ---------------------------------------------------------------------------------------
 // alphabets — 100 letter pieces (iron, 3 cm tall, 5 mm strokes, 1 induced moment per
-// stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible 2000 A·m² moment at
-// the grid centre (|H| ≈ 4.6 Ms at the nearest letters) with an invisible 1.5 cm collider.
+// stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible 30 A·m² moment at
+// the grid centre with an invisible 2 cm collider (|H| ≈ 0.37 Ms at its surface). Stronger
+// moments (100–2000 A·m²) accelerate letters past 50 m/s, more than a 1 ms rigid step resolves
+// (a letter crosses the collider within one step), whatever the magnetization method.
 struct Stroke {
   double x0, y0, x1, y1;  // glyph units: width 2, height 3
 };
@@ -160,15 +163,19 @@ SceneDesc alphabets(const SceneParams& p) {
   c.type = BodyType::Static;
   c.magnet = true;
   c.visible = false;
-  c.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(0.015, 0.015, 0.015)});
+  c.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(0.02, 0.02, 0.02)});
   MomentDesc m;
   m.permanent = true;
-  m.volume = sphere_volume(0.015);
-  m.moment = Vec3(0, 0, 2000.0 * p.strength);
+  m.volume = sphere_volume(0.02);
+  m.moment = Vec3(0, 0, 30.0 * p.strength);
   c.moments.push_back(m);
   s.bodies.push_back(c);
   s.options.gravity = Vec3::Zero();
   s.options.ground = false;
+  // one moment per 3 cm stroke: two strokes crossing put moments ~5 mm apart, inside each
+  // other's equivalent sphere (radius 5.6 mm); soften the dipole sum at that scale
+  s.options.magnetics.field.softening = 0.005;  // (m)
+  s.options.quickstep_iterations = 50;
   s.camera.eye = Eigen::Vector3f(0.45f, -0.55f, 0.30f);
   s.camera.target = Eigen::Vector3f(0, 0, 0);
   s.default_seconds = 3.0;

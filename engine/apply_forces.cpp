@@ -1,0 +1,54 @@
+// engine/apply_forces.cpp — stage 3 of a step (Algorithm 1, "compute F using eq. 4"): one
+// field + Jacobian evaluation at the converged magnetizations gives the force on every
+// moment (the method's force model: Zeeman eq. 4 for ours, classic eqs. 13–14 for Kim 2018)
+// and the torque on permanent moments (τ = μ0 m × H); they act on the dynamic bodies.
+#include "engine/stages.hpp"
+
+#include "magnetics/forces.hpp"
+
+#include <algorithm>
+
+namespace magsim::engine {
+
+void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
+  const mag::Method method = m.options.method;
+  mag::compute_forces(set, mag::force_model_of(method), mag::curve_of(method),
+                      m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau);
+}
+
+void apply_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws,
+                           OdeBridge* ode) {
+  // net magnetic force per body
+  std::fill(ws->body_force.begin(), ws->body_force.end(), Vec3::Zero());
+  for (int j = 0; j < m.nmoment; ++j) {
+    const int b = m.moment_body[j];
+    if (m.body_type[b] == BodyType::Dynamic) ws->body_force[b] += ws->F[j];
+  }
+
+  // auto-disable: ODE sleeps on small velocities only, so wake a sleeping body whose
+  // magnetic load changed by more than 5 % of its weight (|g| taken ≥ 1 m/s²) since it
+  // was last awake, e.g. because a magnet moved
+  if (m.options.auto_disable) {
+    const double g = std::max(m.options.gravity.norm(), 1.0);
+    for (int b : m.dynamic_bodies) {
+      if (m.body_moment_num[b] == 0) continue;
+      if (ode->enabled(b)) {
+        ws->body_force_awake[b] = ws->body_force[b];
+      } else if ((ws->body_force[b] - ws->body_force_awake[b]).norm() > 0.05 * m.body_mass[b] * g) {
+        ode->enable(b);
+        ws->body_force_awake[b] = ws->body_force[b];
+      }
+    }
+  }
+
+  // F at the moment's world position (torque about the COM follows); τ of permanent moments.
+  // Sleeping bodies get nothing: ODE would keep accumulating until they wake.
+  for (int j = 0; j < m.nmoment; ++j) {
+    const int b = m.moment_body[j];
+    if (m.body_type[b] != BodyType::Dynamic || !ode->enabled(b)) continue;
+    ode->add_force_at(b, ws->F[j], set.position[j]);
+    if (m.moment_permanent[j]) ode->add_torque(b, ws->tau[j]);
+  }
+}
+
+}  // namespace magsim::engine

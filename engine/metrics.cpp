@@ -1,0 +1,77 @@
+// engine/metrics.cpp — energy, speed, extent, attachment and momentum of a state.
+#include "engine/metrics.hpp"
+
+#include <algorithm>
+
+namespace magsim::engine {
+
+namespace {
+
+// Dynamic bodies reachable from any magnet body through contact pairs, walking through
+// dynamic bodies only (a ball on the floor is not attached because the floor touches it).
+int count_attached(const Model& m, const State& s) {
+  if (s.contact_pairs.empty()) return 0;
+  std::vector<std::vector<int>> adj(m.nbody);
+  for (const auto& [a, b] : s.contact_pairs) {
+    if (a < 0 || b < 0) continue;  // the ground
+    adj[a].push_back(b);
+    adj[b].push_back(a);
+  }
+  std::vector<std::uint8_t> seen(m.nbody, 0);
+  std::vector<int> queue;
+  for (int b = 0; b < m.nbody; ++b)
+    if (m.body_magnet[b]) {
+      seen[b] = 1;
+      queue.push_back(b);
+    }
+  int attached = 0;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    for (int nb : adj[queue[head]]) {
+      if (seen[nb] || m.body_type[nb] != BodyType::Dynamic) continue;
+      seen[nb] = 1;
+      ++attached;
+      queue.push_back(nb);
+    }
+  }
+  return attached;
+}
+
+}  // namespace
+
+Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last) {
+  Metrics r;
+  r.time = static_cast<double>(s.step) * m.options.dt;
+  r.steps = s.step;
+  r.dynamic_bodies = static_cast<int>(m.dynamic_bodies.size());
+  r.iterations = last.iterations;
+  r.converged = last.converged;
+  r.contacts = last.contacts;
+
+  Vec3 centroid = Vec3::Zero();
+  for (int b : m.dynamic_bodies) {
+    const double mass = m.body_mass[b];
+    const Vec3& v = s.vel[b];
+    const Vec3& w = s.angvel[b];
+    const Mat3 R = s.quat[b].toRotationMatrix();
+    // E = ½ m |v|² + ½ ωᵀ (R I Rᵀ) ω
+    const Vec3 w_body = R.transpose() * w;
+    r.kinetic_energy += 0.5 * mass * v.squaredNorm() + 0.5 * w_body.dot(m.body_inertia[b] * w_body);
+    r.max_speed = std::max(r.max_speed, v.norm());
+    r.momentum += mass * v;
+    centroid += s.pos[b];
+  }
+  if (!m.dynamic_bodies.empty()) {
+    centroid /= static_cast<double>(m.dynamic_bodies.size());
+    for (int b : m.dynamic_bodies) r.bounding_radius = std::max(r.bounding_radius, (s.pos[b] - centroid).norm());
+  }
+  const auto magnet = std::find(m.body_magnet.begin(), m.body_magnet.end(), 1);
+  if (magnet != m.body_magnet.end()) {
+    const int mb = static_cast<int>(magnet - m.body_magnet.begin());
+    for (int b : m.dynamic_bodies)
+      if (!m.body_magnet[b]) r.magnet_radius = std::max(r.magnet_radius, (s.pos[b] - s.pos[mb]).norm());
+  }
+  r.attached = count_attached(m, s);
+  return r;
+}
+
+}  // namespace magsim::engine

@@ -1,0 +1,294 @@
+// engine/model.cpp — SceneDesc → Model: validation, mass properties, moment tables.
+//
+// Everything a step reads but never writes is computed here once: COM frames, inertia
+// tensors, shape and moment offsets in the COM frame, and which moment belongs to which
+// body. Validation happens here too, so the step can assume finite, positive inputs.
+#include "engine/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace magsim::engine {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+bool finite(const Quat& q) { return q.coeffs().allFinite(); }
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+std::string fmt(const Vec3& v) {
+  std::ostringstream s;
+  s << '[' << v.x() << ", " << v.y() << ", " << v.z() << ']';
+  return s.str();
+}
+
+[[noreturn]] void fail(const std::string& where, const std::string& what) {
+  throw std::invalid_argument(where + ": " + what);
+}
+
+std::string body_where(int i, const std::string& name) {
+  return "body " + std::to_string(i) + " '" + name + "'";
+}
+
+void check_options(const SimOptions& o, const Vec3& H0) {
+  if (!(o.dt > 0 && o.dt <= 0.1)) fail("options.dt", "must be in (0, 0.1] s (got " + fmt(o.dt) + ")");
+  if (!finite(o.gravity)) fail("options.gravity", "must be finite (got " + fmt(o.gravity) + ")");
+  if (!(o.friction >= 0 && std::isfinite(o.friction)))
+    fail("options.friction", "must be >= 0 and finite (got " + fmt(o.friction) + ")");
+  if (!(o.restitution >= 0 && o.restitution <= 1))
+    fail("options.restitution", "must be in [0, 1] (got " + fmt(o.restitution) + ")");
+  if (!(o.erp >= 0 && o.erp <= 1)) fail("options.erp", "must be in [0, 1] (got " + fmt(o.erp) + ")");
+  if (!(o.cfm >= 0 && std::isfinite(o.cfm))) fail("options.cfm", "must be >= 0 and finite (got " + fmt(o.cfm) + ")");
+  if (o.quickstep_iterations < 1)
+    fail("options.quickstep_iterations", "must be >= 1 (got " + std::to_string(o.quickstep_iterations) + ")");
+  if (o.max_contacts < 1 || o.max_contacts > 64)
+    fail("options.max_contacts", "must be in [1, 64] (got " + std::to_string(o.max_contacts) + ")");
+  if (!(o.linear_damping >= 0 && std::isfinite(o.linear_damping)))
+    fail("options.linear_damping", "must be >= 0 and finite (got " + fmt(o.linear_damping) + ")");
+  if (!(o.angular_damping >= 0 && std::isfinite(o.angular_damping)))
+    fail("options.angular_damping", "must be >= 0 and finite (got " + fmt(o.angular_damping) + ")");
+  if (!(o.surface_layer >= 0 && std::isfinite(o.surface_layer)))
+    fail("options.surface_layer", "must be >= 0 and finite (got " + fmt(o.surface_layer) + ")");
+  if (!(o.max_correcting_velocity >= 0))
+    fail("options.max_correcting_velocity", "must be >= 0 (0 = unlimited) (got " + fmt(o.max_correcting_velocity) + ")");
+  if (!std::isfinite(o.contact_margin))
+    fail("options.contact_margin", "must be finite (< 0 = auto, 0 = off) (got " + fmt(o.contact_margin) + ")");
+  if (o.threads < 0) fail("options.threads", "must be >= 0 (got " + std::to_string(o.threads) + ")");
+  if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
+  mag::DynamicsOptions d = o.magnetics;
+  d.method = o.method;
+  const std::string e = mag::validate(d);
+  if (!e.empty()) fail("options.magnetics", e);
+}
+
+void check_shape(const std::string& where, int k, const ShapeDesc& s) {
+  const std::string w = where + ": shapes[" + std::to_string(k) + "]";
+  if (!finite(s.offset)) fail(w + ".offset", "must be finite (got " + fmt(s.offset) + ")");
+  if (!finite(s.rotation) || s.rotation.norm() < 1e-12)
+    fail(w + ".rotation", "must be a finite non-zero quaternion");
+  if (!finite(s.size)) fail(w + ".size", "must be finite (got " + fmt(s.size) + ")");
+  switch (s.kind) {
+    case ShapeKind::Sphere:
+      if (!(s.size.x() > 0)) fail(w + ".size", "sphere radius must be > 0 (got " + fmt(s.size.x()) + ")");
+      break;
+    case ShapeKind::Box:
+      if (!(s.size.minCoeff() > 0))
+        fail(w + ".size", "box half extents must be > 0 (got " + fmt(s.size) + ")");
+      break;
+    case ShapeKind::Capsule:
+    case ShapeKind::Cylinder:
+      if (!(s.size.x() > 0 && s.size.y() > 0))
+        fail(w + ".size", "radius and half length must be > 0 (got " + fmt(s.size) + ")");
+      break;
+  }
+}
+
+void check_moment(const std::string& where, int k, const MomentDesc& m) {
+  const std::string w = where + ": moments[" + std::to_string(k) + "]";
+  if (!finite(m.offset)) fail(w + ".offset", "must be finite (got " + fmt(m.offset) + ")");
+  if (!(m.volume > 0 && std::isfinite(m.volume)))
+    fail(w + ".volume", "must be > 0 and finite (got " + fmt(m.volume) + ")");
+  if (m.permanent) {
+    if (!finite(m.moment)) fail(w + ".moment", "must be finite (got " + fmt(m.moment) + ")");
+  } else if (!(m.Ms > 0 && std::isfinite(m.Ms))) {
+    fail(w + ".Ms", "must be > 0 and finite (got " + fmt(m.Ms) + ")");
+  }
+}
+
+void check_body(int i, const BodyDesc& b, const std::string& name) {
+  const std::string w = body_where(i, name);
+  if (!finite(b.position)) fail(w, "position is not finite (" + fmt(b.position) + ")");
+  if (!finite(b.orientation) || b.orientation.norm() < 1e-12)
+    fail(w, "orientation must be a finite non-zero quaternion");
+  if (!finite(b.velocity)) fail(w, "velocity is not finite (" + fmt(b.velocity) + ")");
+  if (!finite(b.angular_velocity))
+    fail(w, "angular_velocity is not finite (" + fmt(b.angular_velocity) + ")");
+  if (!(b.mass >= 0 && std::isfinite(b.mass)))
+    fail(w, "mass must be >= 0 and finite, 0 = density x volume (got " + fmt(b.mass) + ")");
+  if (b.type == BodyType::Dynamic && b.mass == 0 && !(b.density > 0 && std::isfinite(b.density)))
+    fail(w, "density must be > 0 and finite (got " + fmt(b.density) + ")");
+  if (b.type == BodyType::Dynamic && b.shapes.empty())
+    fail(w, "shapes: a dynamic body needs at least one shape (it has no mass otherwise)");
+  for (float c : {b.color.r, b.color.g, b.color.b})
+    if (!(c >= 0.0f && c <= 1.0f)) fail(w, "color components must be in [0, 1]");
+  for (std::size_t k = 0; k < b.shapes.size(); ++k) check_shape(w, static_cast<int>(k), b.shapes[k]);
+  for (std::size_t k = 0; k < b.moments.size(); ++k) check_moment(w, static_cast<int>(k), b.moments[k]);
+}
+
+}  // namespace
+
+// Solid of density 1 about its centre, in its own axes (capsule/cylinder along z, h = half
+// length of the axis segment):
+//   sphere    V = 4/3 π r³,  I = 2/5 V r² 𝟙
+//   box       V = 8 hx hy hz, I_xx = V (hy² + hz²)/3, …
+//   cylinder  V = 2π r² h,   I_zz = V r²/2, I_xx = V (r²/4 + h²/3)
+//   capsule   cylinder + sphere V_s = 4/3 π r³ split into two caps:
+//             I_zz += 2/5 V_s r², I_xx += V_s (2/5 r² + h² + 3/4 h r)
+double shape_volume_inertia(ShapeKind kind, const Vec3& size, Mat3* I) {
+  I->setZero();
+  const double r = size.x();
+  switch (kind) {
+    case ShapeKind::Sphere: {
+      const double V = 4.0 / 3.0 * kPi * r * r * r;
+      I->diagonal().setConstant(0.4 * V * r * r);
+      return V;
+    }
+    case ShapeKind::Box: {
+      const double x = size.x(), y = size.y(), z = size.z();
+      const double V = 8.0 * x * y * z;
+      I->diagonal() << V * (y * y + z * z) / 3.0, V * (x * x + z * z) / 3.0, V * (x * x + y * y) / 3.0;
+      return V;
+    }
+    case ShapeKind::Cylinder:
+    case ShapeKind::Capsule: {
+      const double h = size.y();
+      const double Vc = 2.0 * kPi * r * r * h;
+      double Ixx = Vc * (r * r / 4.0 + h * h / 3.0);
+      double Izz = Vc * r * r / 2.0;
+      double V = Vc;
+      if (kind == ShapeKind::Capsule) {
+        const double Vs = 4.0 / 3.0 * kPi * r * r * r;
+        Ixx += Vs * (0.4 * r * r + h * h + 0.75 * h * r);
+        Izz += Vs * 0.4 * r * r;
+        V += Vs;
+      }
+      I->diagonal() << Ixx, Ixx, Izz;
+      return V;
+    }
+  }
+  return 0.0;
+}
+
+double shape_bounding_radius(ShapeKind kind, const Vec3& size) {
+  switch (kind) {
+    case ShapeKind::Sphere: return size.x();
+    case ShapeKind::Box: return size.norm();
+    case ShapeKind::Capsule: return size.x() + size.y();
+    case ShapeKind::Cylinder: return std::hypot(size.x(), size.y());
+  }
+  return 0.0;
+}
+
+Model compile_model(const SceneDesc& scene) {
+  check_options(scene.options, scene.H0);
+
+  Model m;
+  m.options = scene.options;
+  m.options.magnetics.method = scene.options.method;
+  m.H0 = scene.H0;
+  m.camera = scene.camera;
+  m.name = scene.name;
+  m.description = scene.description;
+  m.modelling_level = scene.modelling_level;
+  m.nbody = static_cast<int>(scene.bodies.size());
+
+  for (int i = 0; i < m.nbody; ++i) {
+    const BodyDesc& b = scene.bodies[i];
+    const std::string name = b.name.empty() ? "body_" + std::to_string(i) : b.name;
+    check_body(i, b, name);
+
+    // mass properties of the shapes, in the BodyDesc frame
+    double V = 0.0;
+    std::vector<double> Vs(b.shapes.size());
+    std::vector<Mat3> Is(b.shapes.size());
+    for (std::size_t k = 0; k < b.shapes.size(); ++k) {
+      Vs[k] = shape_volume_inertia(b.shapes[k].kind, b.shapes[k].size, &Is[k]);
+      V += Vs[k];
+    }
+    double mass = 0.0;
+    Vec3 com = Vec3::Zero();
+    Mat3 inertia = Mat3::Zero();
+    if (b.type == BodyType::Dynamic) {
+      mass = b.mass > 0 ? b.mass : b.density * V;
+      const double rho = mass / V;  // uniform density that gives the stated mass
+      for (std::size_t k = 0; k < b.shapes.size(); ++k) com += rho * Vs[k] * b.shapes[k].offset;
+      com /= mass;
+      // I = Σ_s ρ R_s I_s R_sᵀ + m_s (|d|² 𝟙 − d dᵀ),  d = o_s − c  (parallel axes)
+      for (std::size_t k = 0; k < b.shapes.size(); ++k) {
+        const Mat3 R = b.shapes[k].rotation.normalized().toRotationMatrix();
+        const Vec3 d = b.shapes[k].offset - com;
+        const double ms = rho * Vs[k];
+        inertia += rho * R * Is[k] * R.transpose() +
+                   ms * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+      }
+      if (!(mass > 0 && std::isfinite(mass) && inertia.allFinite()))
+        fail(body_where(i, name), "mass properties are not positive and finite (mass " + fmt(mass) + ")");
+    } else if (b.type == BodyType::Kinematic) {
+      // ODE needs a valid mass on every body; a kinematic body never uses it
+      mass = 1.0;
+      inertia = Mat3::Identity() * 1e-3;
+    }
+    // non-dynamic bodies keep the BodyDesc frame (c = 0): their scripted motion is about
+    // the origin the scene author chose
+
+    const Quat q = b.orientation.normalized();
+    m.body_name.push_back(name);
+    m.body_type.push_back(b.type);
+    m.body_mass.push_back(mass);
+    m.body_inertia.push_back(0.5 * (inertia + inertia.transpose()));
+    m.body_com.push_back(com);
+    m.body_pos0.push_back(b.position + q * com);
+    m.body_quat0.push_back(q);
+    m.body_vel0.push_back(b.velocity);
+    m.body_angvel0.push_back(b.angular_velocity);
+    m.body_color.push_back(b.color);
+    m.body_visible.push_back(b.visible ? 1 : 0);
+    m.body_magnet.push_back(b.magnet ? 1 : 0);
+    m.body_shape_adr.push_back(m.nshape);
+    m.body_shape_num.push_back(static_cast<int>(b.shapes.size()));
+    m.body_moment_adr.push_back(m.nmoment);
+    m.body_moment_num.push_back(static_cast<int>(b.moments.size()));
+
+    double radius = 0.0;
+    for (const ShapeDesc& s : b.shapes) {
+      m.shape_kind.push_back(s.kind);
+      m.shape_body.push_back(i);
+      m.shape_offset.push_back(s.offset - com);
+      m.shape_rot.push_back(s.rotation.normalized());
+      m.shape_size.push_back(s.size);
+      const double sr = shape_bounding_radius(s.kind, s.size);
+      m.shape_radius.push_back(sr);
+      radius = std::max(radius, (s.offset - com).norm() + sr);
+      ++m.nshape;
+    }
+    m.body_radius.push_back(radius);
+
+    for (const MomentDesc& md : b.moments) {
+      m.moment_body.push_back(i);
+      m.moment_offset.push_back(md.offset - com);
+      m.moment_permanent.push_back(md.permanent ? 1 : 0);
+      m.moment_volume.push_back(md.volume);
+      m.moment_Ms.push_back(md.permanent ? 0.0 : md.Ms);
+      m.moment_m.push_back(md.permanent ? md.moment : Vec3::Zero());
+      m.moment_radius.push_back(std::cbrt(3.0 * md.volume / (4.0 * kPi)));
+      if (!md.permanent) ++m.induced_count;
+      if (b.type == BodyType::Dynamic) m.dynamic_moments = true;
+      ++m.nmoment;
+    }
+    if (b.type == BodyType::Dynamic) m.dynamic_bodies.push_back(i);
+  }
+
+  // speculative contact margin: auto = a quarter of the smallest shape's radius (its
+  // inscribed radius: the sphere radius, smallest box half extent, capsule/cylinder radius)
+  m.contact_margin = scene.options.contact_margin;
+  if (m.contact_margin < 0) {
+    double rmin = 0.0;
+    for (int s = 0; s < m.nshape; ++s) {
+      const Vec3& z = m.shape_size[s];
+      const double r = m.shape_kind[s] == ShapeKind::Box ? z.minCoeff() : z.x();
+      rmin = s == 0 ? r : std::min(rmin, r);
+    }
+    m.contact_margin = 0.25 * rmin;
+  }
+  return m;
+}
+
+}  // namespace magsim::engine

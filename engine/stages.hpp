@@ -1,0 +1,39 @@
+// engine/stages.hpp — the stages of one rigid step (paper Algorithm 1), one file each:
+//   place_moments.cpp  (1) moments take their world poses from their bodies
+//   magnetize.cpp      (2) magnetization dynamics until converged or capped
+//   apply_forces.cpp   (3) magnetic forces and torques onto the ODE bodies
+//   ode_bridge.cpp     (4) collide + QuickStep
+//   safety.cpp         non-finite checks between the stages
+// step.cpp calls them in order.
+#pragma once
+
+#include "engine/ode_bridge.hpp"
+#include "engine/profile.hpp"
+#include "engine/workspace.hpp"
+#include "magnetics/moments.hpp"
+
+namespace magsim::engine {
+
+// (1) place_moments.cpp
+/// The MomentSet of a model: moment j of the model, group id = its body index, H0 set.
+mag::MomentSet make_moment_set(const Model& model);
+/// World positions p_j = x_b + R_b o_j and permanent moments m_j = R_b m_j^body (M = m/V).
+void place_moments(const Model& model, const State& s, mag::MomentSet* set);
+/// Magnetizations State → MomentSet and back.
+void load_magnetization(const State& s, mag::MomentSet* set);
+void store_magnetization(const mag::MomentSet& set, State* s);
+
+// (2) magnetize.cpp
+/// Relaxes the induced magnetizations (warm-started from `set`) with the model's method,
+/// or solves them exactly for Method::Exact. Fills iterations/converged/cap_hit.
+void magnetize(const Model& model, mag::MomentSet* set, Workspace* ws, StepProfile* prof);
+
+// (3) apply_forces.cpp
+/// Forces and torques on every moment (ws->F, ws->tau) with the method's force model.
+void compute_magnetic_forces(const Model& model, const mag::MomentSet& set, Workspace* ws);
+/// Adds them to the dynamic bodies: F at each moment's world position, τ of permanent
+/// moments as a body torque. Wakes a sleeping body whose magnetic load changed.
+void apply_magnetic_forces(const Model& model, const mag::MomentSet& set, Workspace* ws,
+                           OdeBridge* ode);
+
+}  // namespace magsim::engine

@@ -1,0 +1,73 @@
+// engine/state.cpp — initial state, shape check and the FNV-1a state hash.
+#include "engine/state.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace magsim::engine {
+
+State initial_state(const Model& m) {
+  State s;
+  s.pos = m.body_pos0;
+  s.quat = m.body_quat0;
+  s.vel = m.body_vel0;
+  s.angvel = m.body_angvel0;
+  s.enabled.assign(m.nbody, 1);
+  s.M1.assign(m.nmoment, Vec3::Zero());
+  s.M2.assign(m.nmoment, Vec3::Zero());
+  s.M.assign(m.nmoment, Vec3::Zero());
+  s.seeded.assign(m.nmoment, 0);
+  for (int j = 0; j < m.nmoment; ++j) {
+    if (!m.moment_permanent[j]) continue;
+    // a permanent moment's M = m/V in world axes, M1 = M2 = 0 (as mag::MomentSet keeps it)
+    s.M[j] = (m.body_quat0[m.moment_body[j]] * m.moment_m[j]) / m.moment_volume[j];
+    s.seeded[j] = 1;
+  }
+  return s;
+}
+
+namespace {
+
+// FNV-1a, 64 bit: h ← (h ⊕ byte) · 1099511628211, h₀ = 14695981039346656037
+struct Fnv1a {
+  std::uint64_t h = 14695981039346656037ull;
+  void bytes(const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= c[i];
+      h *= 1099511628211ull;
+    }
+  }
+  void vecs(const std::vector<Vec3>& v) {
+    for (const Vec3& x : v) bytes(x.data(), 3 * sizeof(double));
+  }
+};
+
+}  // namespace
+
+std::uint64_t state_hash(const State& s) {
+  Fnv1a f;
+  f.vecs(s.pos);
+  for (const Quat& q : s.quat) f.bytes(q.coeffs().data(), 4 * sizeof(double));
+  f.vecs(s.vel);
+  f.vecs(s.angvel);
+  f.vecs(s.M1);
+  f.vecs(s.M2);
+  f.vecs(s.M);
+  return f.h;
+}
+
+void check_state_shape(const Model& m, const State& s) {
+  const auto nb = static_cast<std::size_t>(m.nbody);
+  const auto nm = static_cast<std::size_t>(m.nmoment);
+  if (s.pos.size() != nb || s.quat.size() != nb || s.vel.size() != nb || s.angvel.size() != nb ||
+      s.enabled.size() != nb)
+    throw std::invalid_argument("State does not fit the model: expected " + std::to_string(nb) +
+                                " bodies, got " + std::to_string(s.pos.size()));
+  if (s.M1.size() != nm || s.M2.size() != nm || s.M.size() != nm || s.seeded.size() != nm)
+    throw std::invalid_argument("State does not fit the model: expected " + std::to_string(nm) +
+                                " moments, got " + std::to_string(s.M.size()));
+  if (s.step < 0) throw std::invalid_argument("State step count is negative");
+}
+
+}  // namespace magsim::engine

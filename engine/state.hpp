@@ -1,0 +1,45 @@
+// engine/state.hpp — everything that changes during a run (STYLE.md §1): body poses and
+// velocities, sub-magnetizations, the step counter. Plain data: copy it to save, assign it
+// back to restore, hash it to compare runs bit for bit.
+#pragma once
+
+#include "engine/model.hpp"
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace magsim::engine {
+
+struct State {
+  long step = 0;  ///< rigid steps taken; time = step · Δt_r
+
+  // bodies; poses and velocities are those of the centre of mass (the Model's body frame)
+  std::vector<Vec3> pos;               ///< (nbody) m
+  std::vector<Quat> quat;              ///< (nbody) body → world
+  std::vector<Vec3> vel;               ///< (nbody) m/s
+  std::vector<Vec3> angvel;            ///< (nbody) rad/s, world frame
+  std::vector<std::uint8_t> enabled;   ///< (nbody) 0 = put to sleep by ODE's auto-disable
+
+  // moments, in Model / MomentSet order
+  std::vector<Vec3> M1, M2;            ///< (nmoment) sub-magnetizations (A/m)
+  std::vector<Vec3> M;                 ///< (nmoment) magnetization (A/m)
+  std::vector<std::uint8_t> seeded;    ///< (nmoment) the sub-pair axis has been chosen
+
+  /// Body pairs (a < b) in contact during the last step, −1 = the ground plane. Derived
+  /// data kept for metrics (attachment graph); not part of the hash.
+  std::vector<std::pair<int, int>> contact_pairs;
+};
+
+/// The state at t = 0: the scene's poses and velocities, unmagnetized induced moments.
+State initial_state(const Model& model);
+
+/// 64-bit FNV-1a over the exact bytes of poses, velocities and magnetizations (pos, quat,
+/// vel, angvel, M1, M2, M, in that order). Equal hashes ⇔ bit-identical states (up to
+/// hash collisions).
+std::uint64_t state_hash(const State& s);
+
+/// Throws std::invalid_argument when `s` does not fit `model` (array sizes).
+void check_state_shape(const Model& model, const State& s);
+
+}  // namespace magsim::engine

@@ -1,0 +1,99 @@
+// engine/step.cpp — one rigid step, the paper's Algorithm 1 as a table of contents.
+//
+//   (1) moments take their world poses from their bodies     place_moments.cpp
+//   (2) magnetization dynamics until converged or capped      magnetize.cpp
+//   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
+//   (4) collide + QuickStep                                   ode_bridge.cpp
+//   then read back, check for non-finite values, commit       safety.cpp
+//
+// The step works on ws_.next and swaps it into state_ only when every check passes, so
+// state_ is always the last good state; on failure ODE and the moments are rewound to it.
+#include "engine/simulation.hpp"
+
+#include "engine/ode_bridge.hpp"
+#include "engine/stages.hpp"
+
+#include <omp.h>
+#include <utility>
+
+namespace magsim::engine {
+
+void Simulation::step() {
+  const Model& m = *model_;
+  profile_ = StepProfile{};
+  StepProfile& prof = profile_;
+  ScopedTimer total(&prof.total_ms);
+  const long n = state_.step + 1;  // the step being taken, as named in errors
+  omp_set_num_threads(omp_threads_);  // per calling thread; several Simulations may differ
+
+  try {
+    // (1) ODE takes the state; moments take world positions (and permanent moments their
+    //     world orientation) from their bodies
+    {
+      ScopedTimer t(&prof.sync_ms);
+      ode_->write_state(state_);
+      if (inject_body_ >= 0) {
+        ode_->set_velocity(inject_body_, inject_velocity_);
+        inject_body_ = -1;
+      }
+      place_moments(m, state_, &moments_);
+    }
+
+    // (2) magnetization dynamics on the Δt_m clock, warm-started from the last step
+    {
+      ScopedTimer t(&prof.T_i);
+      magnetize(m, &moments_, &ws_, &prof);
+    }
+    check_magnetization(m, moments_, n);
+
+    // (3) forces (eq. 4 or eqs. 13–14) and torques on the dynamic bodies
+    if (m.dynamic_moments) {
+      ScopedTimer t(&prof.T_f);
+      compute_magnetic_forces(m, moments_, &ws_);
+      check_forces(m, ws_, n);
+      apply_magnetic_forces(m, moments_, &ws_, ode_.get());
+    }
+
+    // (4) collide and step the rigid bodies
+    {
+      ScopedTimer t(&prof.T_r);
+      {
+        ScopedTimer c(&prof.collide_ms);
+        ode_->update_margins(state_, ws_.body_force);
+        prof.contacts = ode_->collide(&ws_.next.contact_pairs);
+      }
+      ScopedTimer q(&prof.quickstep_ms);
+      try {
+        ode_->quickstep(n);
+      } catch (const OdeFailure& e) {
+        // name the body that went bad when there is one, else report ODE's own words
+        ode_->read_state(&ws_.next);
+        check_bodies(m, ws_.next, n);
+        throw SimulationError(n, -1, "", "rigid step",
+                              "step " + std::to_string(n) + ": rigid step failed: " + e.what());
+      }
+    }
+
+    // read back, check, commit
+    {
+      ScopedTimer t(&prof.check_ms);
+      State& next = ws_.next;
+      ode_->read_state(&next);
+      store_magnetization(moments_, &next);
+      next.step = n;
+      check_bodies(m, next, n);
+      std::swap(state_, next);
+      place_moments(m, state_, &moments_);  // moments() follows the new poses
+    }
+  } catch (const SimulationError&) {
+    rollback();
+    throw;
+  } catch (const OdeFailure& e) {  // ODE failed outside the step (e.g. in collision)
+    ode_->mark_broken();
+    rollback();
+    throw SimulationError(n, -1, "", "rigid step",
+                          "step " + std::to_string(n) + ": ODE failed: " + e.what());
+  }
+}
+
+}  // namespace magsim::engine

@@ -1,0 +1,22 @@
+// engine/workspace.hpp — per-step scratch (STYLE.md §1): fields, forces, the next state.
+// Sized once; a warm step allocates nothing.
+#pragma once
+
+#include "engine/state.hpp"
+#include "magnetics/magnetization.hpp"
+
+#include <vector>
+
+namespace magsim::engine {
+
+struct Workspace {
+  mag::MagWorkspace mag;          ///< fields, Jacobians, packed sources (magnetics core)
+  std::vector<mag::Vec3> F;       ///< (nmoment) magnetic force on each moment (N)
+  std::vector<mag::Vec3> tau;     ///< (nmoment) magnetic torque on each moment (N·m)
+  std::vector<Vec3> body_force;   ///< (nbody) net magnetic force on each body this step (N)
+  /// (nbody) net magnetic force when the body was last awake (auto-disable wake-up)
+  std::vector<Vec3> body_force_awake;
+  State next;                     ///< the state being computed; swapped in when it checks out
+};
+
+}  // namespace magsim::engine

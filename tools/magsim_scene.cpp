@@ -1,0 +1,434 @@
+// tools/magsim_scene.cpp — runs one scene (from the registry or a JSON file) with one
+// method and writes what happened: summary.json (options, timings T_i/T_f/T_r, iteration
+// statistics, final metrics, per-frame series, state hash, error), states.csv (body poses
+// per frame) and moments.csv (magnetizations per frame).
+//
+//   magsim-scene balls_up --method kim2018 --seconds 2
+//   magsim-scene scenes/examples/two_balls.json --steps 500 --out out/two
+//
+// Exit codes: 0 done, 1 the simulation failed (SimulationError; summary.json holds the
+// error and the last good state), 2 bad usage or a bad scene.
+#include "engine/simulation.hpp"
+#include "scenes/registry.hpp"
+#include "scenes/scene_file.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace engine = magsim::engine;
+namespace mag = magsim::mag;
+namespace scenes = magsim::scenes;
+using nlohmann::json;
+
+namespace {
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Args {
+  std::string scene;
+  std::string method;
+  double seconds = 0.0;
+  long steps = 0;
+  std::string out;
+  double fps = 60.0;
+  bool no_render = false;
+  int threads = 0;
+  int count = 0;
+  double strength = 0.0;
+  double dt_m = 0.0;
+  double tol = 0.0;
+  int max_iter = 0;
+  bool list = false;
+};
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::string registry_names() {
+  std::string names;
+  for (const scenes::SceneEntry& e : scenes::registry()) names += (names.empty() ? "" : ", ") + std::string(e.name);
+  return names;
+}
+
+// The scene named on the command line, with the command line's overrides applied.
+engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
+  engine::SceneDesc s;
+  if (ends_with(a.scene, ".json")) {
+    if (app.count("--count")) throw UsageError("--count applies to registry scenes only, not to " + a.scene);
+    try {
+      s = scenes::load_scene_file(a.scene);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(e.what());
+    }
+    if (app.count("--strength"))
+      for (engine::BodyDesc& b : s.bodies)
+        for (engine::MomentDesc& m : b.moments)
+          if (m.permanent) m.moment *= a.strength;
+  } else {
+    const scenes::SceneEntry* e = scenes::find_scene(a.scene);
+    if (!e) throw UsageError("unknown scene '" + a.scene + "'; known: " + registry_names() + " (or a FILE.json)");
+    scenes::SceneParams p;
+    if (app.count("--count")) p.count = a.count;
+    if (app.count("--strength")) p.strength = a.strength;
+    s = e->build(p);
+  }
+  if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
+    throw UsageError("unknown method '" + a.method + "'");
+  if (app.count("--threads")) s.options.threads = a.threads;
+  if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
+  if (app.count("--tol")) s.options.magnetics.tol = a.tol;
+  if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
+  s.options.magnetics.method = s.options.method;
+  return s;
+}
+
+// Creates DIR (and parents) and checks that files can be written into it.
+void prepare_out_dir(const std::string& dir) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw UsageError("--out " + dir + ": exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec) throw UsageError("--out " + dir + ": cannot create the directory (" + ec.message() + ")");
+  const fs::path probe = fs::path(dir) / ".magsim_write_test";
+  {
+    std::ofstream f(probe);
+    if (!f || !(f << "ok") || !f.flush()) throw UsageError("--out " + dir + ": directory is not writable");
+  }
+  fs::remove(probe, ec);
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t h = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + h, v.end());
+  const double hi = v[h];
+  if (v.size() % 2) return hi;
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + h));
+}
+
+double sum(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return s;
+}
+
+json vec3(const engine::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+const char* space_name(engine::SpaceKind k) {
+  switch (k) {
+    case engine::SpaceKind::Hash: return "hash";
+    case engine::SpaceKind::SweepAndPrune: return "sap";
+    case engine::SpaceKind::Simple: return "simple";
+  }
+  return "?";
+}
+
+// Per-frame output: states.csv and moments.csv rows, and the series of summary.json.
+class Recorder {
+ public:
+  Recorder(const std::string& dir, const engine::Simulation& sim) : sim_(sim) {
+    states_ = std::fopen((fs::path(dir) / "states.csv").c_str(), "w");
+    moments_ = std::fopen((fs::path(dir) / "moments.csv").c_str(), "w");
+    if (!states_ || !moments_) throw UsageError("--out " + dir + ": cannot create states.csv / moments.csv");
+    std::fprintf(states_, "frame,time,body,name,x,y,z,qw,qx,qy,qz\n");
+    std::fprintf(moments_, "frame,time,moment,body,x,y,z,Mx,My,Mz,M1x,M1y,M1z,M2x,M2y,M2z\n");
+  }
+  ~Recorder() {
+    if (states_) std::fclose(states_);
+    if (moments_) std::fclose(moments_);
+  }
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  /// Writes the current state as the next frame (x, y, z: centre of mass).
+  void frame() {
+    if (sim_.steps() == last_step_) return;
+    last_step_ = sim_.steps();
+    const int f = frames_++;
+    const double t = sim_.time();
+    const engine::Model& m = sim_.model();
+    const engine::State& s = sim_.state();
+    for (int b = 0; b < m.nbody; ++b) {
+      const engine::Vec3& p = s.pos[b];
+      const engine::Quat& q = s.quat[b];
+      std::fprintf(states_, "%d,%.9g,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", f, t, b,
+                   m.body_name[b].c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
+    }
+    const mag::MomentSet& ms = sim_.moments();
+    for (int j = 0; j < m.nmoment; ++j) {
+      const engine::Vec3& p = ms.position[j];
+      std::fprintf(moments_, "%d,%.9g,%d,%d,%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+                   f, t, j, m.moment_body[j], p.x(), p.y(), p.z(), s.M[j].x(), s.M[j].y(), s.M[j].z(),
+                   s.M1[j].x(), s.M1[j].y(), s.M1[j].z(), s.M2[j].x(), s.M2[j].y(), s.M2[j].z());
+    }
+    const engine::Metrics x = sim_.metrics();
+    series_["time"].push_back(t);
+    series_["kinetic_energy"].push_back(x.kinetic_energy);
+    series_["max_speed"].push_back(x.max_speed);
+    series_["bounding_radius"].push_back(x.bounding_radius);
+    series_["magnet_radius"].push_back(x.magnet_radius);
+    series_["attached"].push_back(x.attached);
+    series_["iterations"].push_back(x.iterations);
+    series_["momentum_norm"].push_back(x.momentum.norm());
+    series_["contacts"].push_back(x.contacts);
+  }
+  int frames() const { return frames_; }
+  const json& series() const { return series_; }
+
+ private:
+  const engine::Simulation& sim_;
+  std::FILE* states_ = nullptr;
+  std::FILE* moments_ = nullptr;
+  long last_step_ = -1;
+  int frames_ = 0;
+  json series_ = json::object();
+};
+
+json options_json(const engine::Model& m) {
+  const engine::SimOptions& o = m.options;
+  const mag::DynamicsOptions& d = o.magnetics;
+  return json{{"dt", o.dt},
+              {"dt_m", d.dt},
+              {"beta", d.beta},
+              {"alpha", d.alpha},
+              {"gamma_c_max", d.gamma_c_max},
+              {"adaptive_gamma_bound", d.adaptive_gamma_bound},
+              {"adaptive_gamma_cap", d.adaptive_gamma_cap},
+              {"tol", d.tol},
+              {"max_iter", d.max_iter},
+              {"min_pair_angle", d.min_pair_angle},
+              {"theta_integrator", d.theta_integrator == mag::ThetaIntegrator::Exact ? "exact" : "euler"},
+              {"softening", d.field.softening},
+              {"threads", o.threads},
+              {"gravity", vec3(o.gravity)},
+              {"ground", o.ground},
+              {"friction", o.friction},
+              {"restitution", o.restitution},
+              {"erp", o.erp},
+              {"cfm", o.cfm},
+              {"quickstep_iterations", o.quickstep_iterations},
+              {"max_contacts", o.max_contacts},
+              {"space", space_name(o.space)},
+              {"auto_disable", o.auto_disable},
+              {"linear_damping", o.linear_damping},
+              {"angular_damping", o.angular_damping},
+              {"surface_layer", o.surface_layer},
+              {"max_correcting_velocity", o.max_correcting_velocity},
+              {"contact_margin", m.contact_margin},
+              {"H0", vec3(m.H0)}};
+}
+
+// ---- rendering hook -----------------------------------------------------------------
+// When magsim-scene is built with the renderer (MAGSIM_HAVE_RENDER) and run without
+// --no-render, each recorded frame is to be drawn here: sim.frame(opts) → render::Renderer
+// → DIR/frame_%06d.png (crystal_balls with FrameOptions::magnetization_arrows). Not wired
+// yet: the run prints a note and continues as with --no-render.
+void render_hook_note(bool no_render) {
+  if (no_render) return;
+#ifdef MAGSIM_HAVE_RENDER
+  std::fprintf(stderr, "note: rendering is not wired into magsim-scene yet; continuing as --no-render\n");
+#else
+  std::fprintf(stderr, "note: built without the renderer (MAGSIM_RENDER=OFF); continuing as --no-render\n");
+#endif
+}
+
+int run(const Args& a, const CLI::App& app) {
+  engine::SceneDesc scene = resolve_scene(a, app);
+  const std::string method = mag::method_name(scene.options.method);
+  std::unique_ptr<engine::Simulation> sim_ptr;
+  try {
+    sim_ptr = std::make_unique<engine::Simulation>(scene);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("scene '") + scene.name + "': " + e.what());
+  }
+  engine::Simulation& sim = *sim_ptr;
+  const engine::Model& model = sim.model();
+  const double dt = model.options.dt;
+
+  long n_steps = a.steps;
+  if (!app.count("--steps")) {
+    const double seconds = app.count("--seconds") ? a.seconds : scene.default_seconds;
+    n_steps = std::max(1L, std::lround(seconds / dt));
+  }
+  const long per_frame = std::max(1L, std::lround(1.0 / (a.fps * dt)));
+  const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
+  prepare_out_dir(dir);
+  render_hook_note(a.no_render);
+
+  Recorder rec(dir, sim);
+  std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters;
+  Ti.reserve(n_steps);
+  Tf.reserve(n_steps);
+  Tr.reserve(n_steps);
+  collide.reserve(n_steps);
+  quickstep.reserve(n_steps);
+  total.reserve(n_steps);
+  iters.reserve(n_steps);
+  long cap_hits = 0;
+  std::string error;
+
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  auto last_report = t0;
+  rec.frame();
+  for (long k = 0; k < n_steps; ++k) {
+    try {
+      sim.step();
+    } catch (const engine::SimulationError& e) {
+      error = e.what();
+      break;
+    }
+    const engine::StepProfile& p = sim.last_profile();
+    Ti.push_back(p.T_i);
+    Tf.push_back(p.T_f);
+    Tr.push_back(p.T_r);
+    collide.push_back(p.collide_ms);
+    quickstep.push_back(p.quickstep_ms);
+    total.push_back(p.total_ms);
+    iters.push_back(p.iterations);
+    cap_hits += p.cap_hit ? 1 : 0;
+    if (sim.steps() % per_frame == 0) rec.frame();
+    const auto now = clock::now();
+    if (now - last_report >= std::chrono::seconds(2)) {
+      last_report = now;
+      std::fprintf(stderr,
+                   "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
+                   "iterations %d%s\n",
+                   scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
+                   std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
+                   p.cap_hit ? " (cap)" : "");
+    }
+  }
+  rec.frame();  // the final (or last good) state, when not already on a frame
+  const double wall = std::chrono::duration<double>(clock::now() - t0).count();
+
+  const engine::Metrics fin = sim.metrics();
+  char hash[19];
+  std::snprintf(hash, sizeof hash, "%016" PRIx64, sim.state_hash());
+  auto stats = [](const std::vector<double>& v) { return json{{"median", median(v)}, {"total", sum(v)}}; };
+  json summary{
+      {"scene", scene.name},
+      {"source", ends_with(a.scene, ".json") ? a.scene : "registry"},
+      {"description", scene.description},
+      {"modelling_level", scene.modelling_level},
+      {"method", method},
+      {"options", options_json(model)},
+      {"params", {{"count", a.count}, {"strength", app.count("--strength") ? a.strength : 1.0}}},
+      {"bodies", model.nbody},
+      {"dynamic_bodies", model.dynamic_bodies.size()},
+      {"moments", model.nmoment},
+      {"induced_moments", model.induced_count},
+      {"steps", sim.steps()},
+      {"steps_requested", n_steps},
+      {"seconds", sim.time()},
+      {"fps", a.fps},
+      {"frames", rec.frames()},
+      {"wall_seconds", wall},
+      {"timing_ms",
+       {{"T_i", stats(Ti)},
+        {"T_f", stats(Tf)},
+        {"T_r", stats(Tr)},
+        {"collide", stats(collide)},
+        {"quickstep", stats(quickstep)},
+        {"step", stats(total)}}},
+      {"iterations",
+       {{"median", median(iters)},
+        {"max", iters.empty() ? 0.0 : *std::max_element(iters.begin(), iters.end())},
+        {"mean", iters.empty() ? 0.0 : sum(iters) / static_cast<double>(iters.size())},
+        {"cap_hits", cap_hits}}},
+      {"final",
+       {{"kinetic_energy", fin.kinetic_energy},
+        {"max_speed", fin.max_speed},
+        {"bounding_radius", fin.bounding_radius},
+        {"magnet_radius", fin.magnet_radius},
+        {"attached", fin.attached},
+        {"momentum", vec3(fin.momentum)},
+        {"contacts", fin.contacts}}},
+      {"series", rec.series()},
+      {"state_hash", hash},
+      {"error", error.empty() ? json(nullptr) : json(error)}};
+
+  const fs::path path = fs::path(dir) / "summary.json";
+  std::ofstream out(path);
+  out << summary.dump(1) << '\n';
+  if (!out) {
+    std::fprintf(stderr, "error: cannot write %s\n", path.c_str());
+    return 1;
+  }
+  if (!error.empty()) {
+    std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "%s %s: %ld steps, t = %.4f s, wall %.2f s, median T_i %.3f T_f %.3f T_r %.3f ms; %s\n",
+               scene.name.c_str(), method.c_str(), sim.steps(), sim.time(), wall, median(Ti), median(Tf),
+               median(Tr), path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"magsim-scene: run one scene with one method and write summary.json, states.csv and "
+               "moments.csv"};
+  Args a;
+  app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
+  app.add_option("--method", a.method, "ours | ours-realigned | kim2018 | damping-llg | exact (default: the scene's)")
+      ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "exact"}));
+  auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
+                      ->check(CLI::PositiveNumber);
+  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, 2000000000L));
+  seconds->excludes(steps);
+  steps->excludes(seconds);
+  app.add_option("--out", a.out, "output directory (default: out/<scene>_<method>)");
+  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--no-render", a.no_render, "do not render frames");
+  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics")->check(CLI::Range(1, 1000000000));
+  app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(CLI::Range(1, 1000000000));
+  app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(CLI::PositiveNumber);
+  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
+  app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(CLI::PositiveNumber);
+  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(CLI::Range(1, 1000000000));
+  app.add_flag("--list", a.list, "list the registry's scenes and exit");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+  if (a.list) {
+    for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
+    return 0;
+  }
+  if (a.scene.empty()) {
+    std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
+    return 2;
+  }
+  try {
+    return run(a, app);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}
