@@ -9,6 +9,10 @@
 // Exit codes: 0 done, 1 the simulation failed (SimulationError; summary.json holds the
 // error and the last good state), 2 bad usage or a bad scene.
 #include "engine/simulation.hpp"
+#ifdef MAGSIM_HAVE_RENDER
+#include "render/frame_writer.hpp"
+#include "render/renderer.hpp"
+#endif
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
 
@@ -23,6 +27,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -46,6 +51,8 @@ struct Args {
   std::string out;
   double fps = 60.0;
   bool no_render = false;
+  bool arrows = false;
+  int width = 1280, height = 720, samples = 1;
   int threads = 0;
   int count = 0;
   double strength = 0.0;
@@ -155,9 +162,10 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
-  /// Writes the current state as the next frame (x, y, z: centre of mass).
-  void frame() {
-    if (sim_.steps() == last_step_) return;
+  /// Writes the current state as the next frame (x, y, z: centre of mass); false when this
+  /// step was already written.
+  bool frame() {
+    if (sim_.steps() == last_step_) return false;
     last_step_ = sim_.steps();
     const int f = frames_++;
     const double t = sim_.time();
@@ -186,6 +194,7 @@ class Recorder {
     series_["iterations"].push_back(x.iterations);
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
+    return true;
   }
   int frames() const { return frames_; }
   const json& series() const { return series_; }
@@ -233,19 +242,59 @@ json options_json(const engine::Model& m) {
               {"H0", vec3(m.H0)}};
 }
 
-// ---- rendering hook -----------------------------------------------------------------
-// When magsim-scene is built with the renderer (MAGSIM_HAVE_RENDER) and run without
-// --no-render, each recorded frame is to be drawn here: sim.frame(opts) → render::Renderer
-// → DIR/frame_%06d.png (crystal_balls with FrameOptions::magnetization_arrows). Not wired
-// yet: the run prints a note and continues as with --no-render.
-void render_hook_note(bool no_render) {
-  if (no_render) return;
+// ---- rendering ----------------------------------------------------------------------
+// With the renderer built in (MAGSIM_HAVE_RENDER) and without --no-render, every recorded
+// frame is drawn: sim.frame(opts) → magsim::render::Renderer → DIR/frame_%06d.png, PNGs written by a
+// background thread. crystal_balls (or --arrows) draws M1 (red) and M2 (blue) on every ball.
+class FrameRenderer {
+ public:
+  FrameRenderer(const Args& a, const std::string& dir, bool arrows)
+      : dir_(dir), enabled_(!a.no_render) {
+    if (!enabled_) return;
 #ifdef MAGSIM_HAVE_RENDER
-  std::fprintf(stderr, "note: rendering is not wired into magsim-scene yet; continuing as --no-render\n");
+    renderer_ = std::make_unique<magsim::render::Renderer>(a.width, a.height, a.samples);
+    writer_ = std::make_unique<magsim::render::FrameWriter>(4, 1);
+    opts_.magnetization_arrows = arrows;
+    opts_.arrow_scale = 2.2;  // reach out of the ball to be seen
 #else
-  std::fprintf(stderr, "note: built without the renderer (MAGSIM_RENDER=OFF); continuing as --no-render\n");
+    (void)arrows;
+    std::fprintf(stderr, "note: built without the renderer (MAGSIM_RENDER=OFF); continuing as --no-render\n");
+    enabled_ = false;
 #endif
-}
+  }
+  void draw(const engine::Simulation& sim) {
+    if (!enabled_) return;
+#ifdef MAGSIM_HAVE_RENDER
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer_->draw(sim.frame(opts_));
+    ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    writer_->push(magsim::render::frame_path(dir_, index_++), renderer_->width(), renderer_->height(),
+                  renderer_->pixels());
+#else
+    (void)sim;
+#endif
+  }
+  /// Waits for the PNG writer; throws its first error.
+  void finish() {
+#ifdef MAGSIM_HAVE_RENDER
+    if (writer_) writer_->finish();
+#endif
+  }
+  bool enabled() const { return enabled_; }
+  int frames() const { return index_; }
+  const std::vector<double>& ms() const { return ms_; }
+
+ private:
+  std::string dir_;
+  bool enabled_;
+  int index_ = 0;
+  std::vector<double> ms_;
+  engine::FrameOptions opts_;
+#ifdef MAGSIM_HAVE_RENDER
+  std::unique_ptr<magsim::render::Renderer> renderer_;
+  std::unique_ptr<magsim::render::FrameWriter> writer_;
+#endif
+};
 
 int run(const Args& a, const CLI::App& app) {
   engine::SceneDesc scene = resolve_scene(a, app);
@@ -268,7 +317,7 @@ int run(const Args& a, const CLI::App& app) {
   const long per_frame = std::max(1L, std::lround(1.0 / (a.fps * dt)));
   const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
   prepare_out_dir(dir);
-  render_hook_note(a.no_render);
+  FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
   std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters;
@@ -285,7 +334,7 @@ int run(const Args& a, const CLI::App& app) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   auto last_report = t0;
-  rec.frame();
+  if (rec.frame()) painter.draw(sim);
   for (long k = 0; k < n_steps; ++k) {
     try {
       sim.step();
@@ -302,7 +351,7 @@ int run(const Args& a, const CLI::App& app) {
     total.push_back(p.total_ms);
     iters.push_back(p.iterations);
     cap_hits += p.cap_hit ? 1 : 0;
-    if (sim.steps() % per_frame == 0) rec.frame();
+    if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
     const auto now = clock::now();
     if (now - last_report >= std::chrono::seconds(2)) {
       last_report = now;
@@ -314,7 +363,12 @@ int run(const Args& a, const CLI::App& app) {
                    p.cap_hit ? " (cap)" : "");
     }
   }
-  rec.frame();  // the final (or last good) state, when not already on a frame
+  if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
+  try {
+    painter.finish();
+  } catch (const std::exception& e) {
+    if (error.empty()) error = std::string("writing frames: ") + e.what();
+  }
   const double wall = std::chrono::duration<double>(clock::now() - t0).count();
 
   const engine::Metrics fin = sim.metrics();
@@ -338,6 +392,8 @@ int run(const Args& a, const CLI::App& app) {
       {"seconds", sim.time()},
       {"fps", a.fps},
       {"frames", rec.frames()},
+      {"rendered_frames", painter.frames()},
+      {"render_ms_median", median(painter.ms())},
       {"wall_seconds", wall},
       {"timing_ms",
        {{"T_i", stats(Ti)},
@@ -398,6 +454,10 @@ int main(int argc, char** argv) {
   app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60)")
       ->check(CLI::PositiveNumber);
   app.add_flag("--no-render", a.no_render, "do not render frames");
+  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192))->capture_default_str();
+  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192))->capture_default_str();
+  app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(CLI::Range(1, 4))->capture_default_str();
+  app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
   app.add_option("--threads", a.threads, "OpenMP threads for the magnetics")->check(CLI::Range(1, 1000000000));
   app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(CLI::Range(1, 1000000000));
   app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(CLI::PositiveNumber);
