@@ -13,7 +13,8 @@ namespace magsim::engine {
 void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
   const mag::Method method = m.options.method;
   mag::compute_forces(set, mag::force_model_of(method), mag::curve_of(method),
-                      m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau);
+                      m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
+                      m.options.reaction_symmetric_forces);
 }
 
 void apply_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws,

@@ -74,6 +74,11 @@ struct SimOptions {
     d.max_iter = 100;
     return d;
   }();
+  /// Apply the Zeeman force pairwise antisymmetrized (mag::compute_forces): momentum is
+  /// conserved. false (default) = the per-moment gradient of eq. 4, which breaks action =
+  /// reaction: harmless against a fixed magnet, but in falling_magnet the dynamic magnet and
+  /// the balls on it fly off together at 200 m/s, so that scene turns this on.
+  bool reaction_symmetric_forces = false;
   double dt = 1e-3;                ///< rigid step Δt_r (s)
   Vec3 gravity = Vec3(0, 0, -9.81);  ///< (m/s²)
   bool ground = true;              ///< an infinite static plane z = 0

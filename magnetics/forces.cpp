@@ -23,7 +23,8 @@ Vec3 classic_force(const Vec3& m, const Mat3& J) { return kMu0 * (J * m); }
 
 void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
                     const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
-                    std::vector<Vec3>* tau, std::vector<Vec3>* F_classic) {
+                    std::vector<Vec3>* tau, std::vector<Vec3>* F_classic,
+                    bool reaction_symmetric) {
   compute_fields(set, field, &ws->H, &ws->J, &ws->field);
   const long n = static_cast<long>(set.size());
   F->resize(n);
@@ -46,6 +47,18 @@ void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
       if (tau) (*tau)[j] = Vec3::Zero();
     }
   }
+  if (!(reaction_symmetric && model == ForceModel::Zeeman)) return;
+  // the effective moments m̃_j = V_j [A_j(2M_j + H_j) + M_j] as sources (scratch set reused)
+  MomentSet& eff = ws->effective;
+  eff = set;
+  for (long j = 0; j < n; ++j) {
+    if (set.kind[j] != MomentKind::Induced) continue;
+    const Mat3 A = curve_dMdH(curve, ws->H[j], set.Ms[j]);
+    eff.M[j] = A * (2.0 * set.M[j] + ws->H[j]) + set.M[j];
+  }
+  compute_fields(eff, field, &ws->H_eff_src, &ws->J_eff_src, &ws->field);
+  // F_j = ½ (F_zeeman,j + μ0 J̃_j m_j)
+  for (long j = 0; j < n; ++j) (*F)[j] = 0.5 * ((*F)[j] + classic_force(set.moment(j), ws->J_eff_src[j]));
 }
 
 }  // namespace magsim::mag

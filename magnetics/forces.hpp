@@ -20,8 +20,18 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// Jacobians are evaluated here from the current magnetizations, into ws->H and ws->J).
 /// Induced: the model's force, no torque (M ∥ H). Permanent: F = μ0 J m, τ = μ0 m × H.
 /// F_classic (optional) receives the classic force of every moment as well.
+///
+/// reaction_symmetric (Zeeman only): the Zeeman force on j is the classic pair force with m_j
+/// replaced by the effective moment m̃_j = V_j [A_j(2M_j + H_j) + M_j] (m̃ = m for permanent
+/// moments), so per pair it is F_{j←i} = μ0 J(r_ji; m_i) m̃_j and F_{i←j} ≠ −F_{j←i}: the
+/// set of moments pushes itself (a dynamic magnet with iron stuck to it flies off). The
+/// symmetric force applies each pair's antisymmetric part,
+///   F_j = ½ μ0 Σ_i [J(r_ji; m_i) m̃_j + J(r_ji; m̃_i) m_j] = ½ (F_zeeman,j + μ0 J̃_j m_j),
+/// J̃ the Jacobian of the field of the effective moments: one more field evaluation, and
+/// Σ_j F_j = 0 exactly (Algorithm 1 computes F "for each pair of magnetic moments").
 void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
                     const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
-                    std::vector<Vec3>* tau, std::vector<Vec3>* F_classic = nullptr);
+                    std::vector<Vec3>* tau, std::vector<Vec3>* F_classic = nullptr,
+                    bool reaction_symmetric = false);
 
 }  // namespace magsim::mag

@@ -6,6 +6,7 @@
 // loop after one field evaluation.
 #include "magnetics/magnetization.hpp"
 
+#include "magnetics/anderson.hpp"
 #include "magnetics/curves.hpp"
 
 #include <algorithm>
@@ -30,8 +31,16 @@ std::string validate(const DynamicsOptions& o) {
   else if (o.max_iter < 1) e << "max_iter must be >= 1, got " << o.max_iter;
   else if (!(o.min_pair_angle > 0 && o.min_pair_angle < 1e-2))
     e << "min_pair_angle must be in (0, 0.01) rad, got " << o.min_pair_angle;
-  else if (!(o.field.softening >= 0 && std::isfinite(o.field.softening)))
-    e << "softening must be >= 0, got " << o.field.softening;
+  else if (o.anderson_depth < 0 || o.anderson_depth > 50)
+    e << "anderson_depth must be in [0, 50], got " << o.anderson_depth;
+  else if (!(o.anderson_damping > 0 && o.anderson_damping <= 1))
+    e << "anderson_damping must be in (0, 1], got " << o.anderson_damping;
+  else if (!(o.anderson_restart_growth > 1 && std::isfinite(o.anderson_restart_growth)))
+    e << "anderson_restart_growth must be > 1, got " << o.anderson_restart_growth;
+  else {
+    const std::string f = validate(o.field);
+    if (!f.empty()) return f;
+  }
   return e.str();
 }
 
@@ -170,16 +179,23 @@ void update_pair(Method method, const DynamicsOptions& opt, double Ms, const Vec
       llg_step(false, opt, Ms, Heff, M2);
       break;
     case Method::Exact:
+    case Method::Anderson:  // no dynamics: these methods set M = f(H) (see anderson.hpp)
       break;
   }
   keep_pair_apart(Ms, opt.min_pair_angle, M1, M2);
 }
 
-double magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws) {
+SweepStats magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws) {
+  if (opt.method == Method::Anderson) {
+    // a Picard step sets M = f(H): its change is the residual of the previous iterate
+    const double c = picard_iteration(set, opt, ws);
+    return {c, c};
+  }
   compute_fields(*set, opt.field, &ws->H, nullptr, &ws->field);
   const long n = static_cast<long>(set->size());
-  double max_change = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : max_change)
+  const Curve curve = curve_of(opt.method);
+  double max_change = 0.0, max_res = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : max_change, max_res)
   for (long j = 0; j < n; ++j) {
     if (set->kind[j] != MomentKind::Induced) continue;
     const double Ms = set->Ms[j];
@@ -195,23 +211,29 @@ double magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWo
       set->seeded[j] = 1;
     }
     const Vec3 M_old = set->M[j];
+    max_res = std::max(max_res, (M_old - curve_M(curve, H, Ms)).norm() / Ms);
     const Vec3 Heff = effective_field(opt.method, opt, H, M_old, Ms);
     update_pair(opt.method, opt, Ms, Heff, &M1, &M2);
     const Vec3 M_new = 0.5 * (M1 + M2);
     set->M[j] = M_new;
     max_change = std::max(max_change, (M_new - M_old).norm() / Ms);
   }
-  return max_change;
+  return {max_change, max_res};
 }
 
 RelaxStats relax_magnetization(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
                                const std::function<void(int, const MomentSet&)>& on_iteration) {
+  if (opt.method == Method::Anderson) return relax_anderson(set, opt, ws, on_iteration);
   RelaxStats st;
   for (int k = 1; k <= opt.max_iter; ++k) {
-    st.last_change = magnetization_iteration(set, opt, ws);
+    const SweepStats sw = magnetization_iteration(set, opt, ws);
+    st.last_change = sw.change;
+    st.last_residual = sw.residual;
     st.iterations = k;
     if (on_iteration) on_iteration(k, *set);
-    if (st.last_change < opt.tol) {
+    const double crit =
+        opt.criterion == DynamicsOptions::Criterion::Residual ? sw.residual : sw.change;
+    if (crit < opt.tol) {
       st.converged = true;
       break;
     }

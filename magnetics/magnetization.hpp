@@ -27,40 +27,83 @@ struct DynamicsOptions {
   /// The raised bound is used only while it is ≤ min(adaptive_gamma_cap, 2/k), k = β Δt Ms
   /// (beyond, |H| ≳ 2.5 Ms and the fixed bound applies again: |M| = Ms to < 1e-6).
   double adaptive_gamma_cap = 2.5;
-  double tol = 1e-6;           ///< converged when every |ΔM_j|/Ms_j < tol in one iteration
+  double tol = 1e-6;           ///< converged when the criterion's value < tol
+  /// What tol bounds. Residual (default): max_j |M_j − f(H_j)|/Ms_j of the iterate the
+  /// sweep's fields came from — free, since H is computed anyway, and it does not stop a
+  /// slow method early the way a small per-sweep change does. Change: max_j |ΔM_j|/Ms_j over
+  /// one sweep (DESIGN §1.7's wording).
+  enum class Criterion : std::uint8_t { Residual, Change } criterion = Criterion::Residual;
   int max_iter = 999;          ///< iteration cap per solve
   /// Floor (rad) of the half-angle between M_j1 and M_j2: a pair closer than this is spread
   /// back to it about M (|M| changes by < φ²/2 = 5e-13 relative), so the two
   /// sub-magnetizations can never collapse onto each other (DESIGN §6).
   double min_pair_angle = 1e-6;
   ThetaIntegrator theta_integrator = ThetaIntegrator::Exact;
+  /// Method::Anderson: how many past residuals the least-squares mixing uses (0 = plain
+  /// Picard iteration M ← f(H(M))).
+  int anderson_depth = 5;
+  /// Method::Anderson: damping β ∈ (0, 1] of the mixing x + β (f(H(x)) − x).
+  double anderson_damping = 1.0;
+  /// Method::Anderson: the history is dropped (restart) when the residual grows by more
+  /// than this factor in one iteration.
+  double anderson_restart_growth = 2.0;
   FieldOptions field;
 };
 
 /// Empty when the options are usable, else a one-line reason.
 std::string validate(const DynamicsOptions& opt);
 
+/// History of the Anderson solve (Method::Anderson, magnetics/anderson.cpp). Vectors stack
+/// the induced magnetizations divided by Ms (3k entries for k induced moments); sized on the
+/// first iteration of a solve, not reallocated after.
+struct AndersonHistory {
+  std::vector<int> idx;                 ///< (k) induced moment indices
+  std::vector<double> x, g, f;          ///< (3k) iterate, its Picard image f(H(x)), g − x
+  std::vector<double> x_prev, f_prev;   ///< (3k) the previous iterate and residual
+  std::vector<double> dX, dF;           ///< (3k × depth) ring of iterate / residual differences
+  std::vector<double> Q;                ///< (3k × depth) orthonormal basis of the dF columns
+  std::vector<double> R, gamma;         ///< (depth × depth), (depth) least-squares scratch
+  int cols = 0;                         ///< differences held
+  int head = 0;                         ///< ring slot of the next difference
+  double beta = 1.0;                    ///< current damping
+};
+
 /// Scratch of a solve: fields, Jacobians and the packed sources. Reused across steps.
 struct MagWorkspace {
   FieldWorkspace field;
   std::vector<Vec3> H;  ///< (n) field at each moment from the latest evaluation (A/m)
   std::vector<Mat3> J;  ///< (n) ∂H/∂p at each moment (A/m²), filled by force evaluation
+  MomentSet effective;          ///< scratch: effective moments (reaction-symmetric forces)
+  std::vector<Vec3> H_eff_src;  ///< (n) field of the effective moments (scratch)
+  std::vector<Mat3> J_eff_src;  ///< (n) its Jacobian (scratch)
   std::vector<Mat3> A;  ///< (n) scratch for the Newton solver
+  AndersonHistory anderson;  ///< Method::Anderson only
 };
 
 struct RelaxStats {
-  int iterations = 0;        ///< Jacobi sweeps taken
-  bool converged = false;    ///< the last sweep changed every M by less than tol
-  double last_change = 0.0;  ///< max_j |ΔM_j|/Ms_j of the last sweep
+  int iterations = 0;          ///< Jacobi sweeps taken
+  bool converged = false;      ///< the criterion fell below tol
+  double last_change = 0.0;    ///< max_j |ΔM_j|/Ms_j of the last sweep
+  double last_residual = 0.0;  ///< max_j |M_j − f(H_j)|/Ms_j before the last sweep
+};
+
+/// What one sweep measured.
+struct SweepStats {
+  double change = 0.0;    ///< max_j |ΔM_j|/Ms_j
+  double residual = 0.0;  ///< max_j |M_j − f(H_j)|/Ms_j of the iterate before the sweep
 };
 
 /// One Jacobi sweep (every moment updates from the fields of the previous iterate):
-/// fields → H_eff → sub-magnetization update per the method. Returns max_j |ΔM_j|/Ms_j.
+/// fields → H_eff → sub-magnetization update per the method; returns the sweep's change
+/// and the residual of the iterate before it.
 /// Fields are left in ws->H (they belong to the iterate *before* the update).
-double magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws);
+/// Method::Anderson has no history here: its sweep is the plain Picard step M ← f(H(M)).
+SweepStats magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws);
 
 /// Sweeps until converged or opt.max_iter; warm-starts from the state in `set`.
 /// `on_iteration(k, set)` (optional) is called after sweep k = 1, 2, …
+/// Method::Anderson runs the Anderson-accelerated Picard solve of magnetics/anderson.hpp
+/// instead (one field evaluation per iteration, the same stopping rule and cap).
 RelaxStats relax_magnetization(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
                                const std::function<void(int, const MomentSet&)>& on_iteration = {});
 

@@ -14,13 +14,14 @@ const char* method_name(Method m) {
     case Method::Kim2018: return "kim2018";
     case Method::DampingLLG: return "damping-llg";
     case Method::Exact: return "exact";
+    case Method::Anderson: return "anderson";
   }
   return "?";
 }
 
 bool parse_method(const std::string& name, Method* out) {
   for (Method m : {Method::Ours, Method::OursRealigned, Method::Kim2018, Method::DampingLLG,
-                   Method::Exact}) {
+                   Method::Exact, Method::Anderson}) {
     if (name == method_name(m)) {
       *out = m;
       return true;

@@ -18,8 +18,9 @@ inline constexpr double kMu0 = 4e-7 * kPi;  ///< vacuum permeability (T·m/A)
 
 enum class MomentKind : std::uint8_t { Induced, Permanent };
 
-/// Magnetization dynamics / solver. Exact is the Newton ground truth (no dynamics).
-enum class Method : std::uint8_t { Ours, OursRealigned, Kim2018, DampingLLG, Exact };
+/// Magnetization dynamics / solver. Exact is the Newton ground truth (no dynamics);
+/// Anderson solves M = f(H(M)) by Anderson-accelerated Picard iteration (beyond the paper).
+enum class Method : std::uint8_t { Ours, OursRealigned, Kim2018, DampingLLG, Exact, Anderson };
 
 /// Magnetization curve M = f(H).
 enum class Curve : std::uint8_t {
@@ -40,7 +41,7 @@ inline ForceModel force_model_of(Method m) {
   return m == Method::Kim2018 ? ForceModel::Classic : ForceModel::Zeeman;
 }
 
-/// "ours", "ours-realigned", "kim2018", "damping-llg", "exact".
+/// "ours", "ours-realigned", "kim2018", "damping-llg", "exact", "anderson".
 const char* method_name(Method m);
 /// Parses a method name; returns false (and leaves *out alone) on an unknown name.
 bool parse_method(const std::string& name, Method* out);

@@ -309,7 +309,7 @@ BodyDesc read_body(const Reader& r, const json& j, const std::string& path, std:
 
 void read_magnetics(const Reader& r, const json& j, const std::string& path, mag::DynamicsOptions* d) {
   r.keys(j, path, {"dt", "beta", "alpha", "gamma_c_max", "adaptive_gamma_bound", "adaptive_gamma_cap",
-                   "tol", "max_iter", "min_pair_angle", "theta_integrator", "softening"});
+                   "tol", "criterion", "max_iter", "min_pair_angle", "theta_integrator", "softening"});
   opt(j, "dt", path, [&](const json& v, const std::string& p) { d->dt = r.in_range(v, p, 1e-9, 1e-6); });
   opt(j, "beta", path, [&](const json& v, const std::string& p) { d->beta = r.positive(v, p); });
   opt(j, "alpha", path, [&](const json& v, const std::string& p) { d->alpha = r.in_range(v, p, 1e-12, 1.0); });
@@ -325,6 +325,12 @@ void read_magnetics(const Reader& r, const json& j, const std::string& path, mag
     else if (s == "euler") d->theta_integrator = mag::ThetaIntegrator::Euler;
     else r.fail(p, "unknown theta integrator '" + s + "' (exact, euler)");
   });
+  opt(j, "criterion", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (s == "residual") d->criterion = mag::DynamicsOptions::Criterion::Residual;
+    else if (s == "change") d->criterion = mag::DynamicsOptions::Criterion::Change;
+    else r.fail(p, "unknown criterion '" + s + "' (residual, change)");
+  });
   opt(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.non_negative(v, p); });
   const std::string e = mag::validate(*d);
   if (!e.empty()) r.fail(path, e);
@@ -334,7 +340,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
   r.keys(j, path, {"method", "dt", "gravity", "ground", "friction", "restitution", "erp", "cfm",
                    "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
-                   "threads", "magnetics"});
+                   "threads", "reaction_symmetric_forces", "magnetics"});
   opt(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   opt(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
@@ -356,6 +362,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
   opt(j, "max_correcting_velocity", path, [&](const json& v, const std::string& p) { o->max_correcting_velocity = r.non_negative(v, p); });
   opt(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
   opt(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = r.integer(v, p, 0, 1024); });
+  opt(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
   opt(j, "magnetics", path, [&](const json& v, const std::string& p) { read_magnetics(r, v, p, &o->magnetics); });
   o->magnetics.method = o->method;
 }

@@ -79,7 +79,7 @@ TEST_CASE("strong field: Kim 2018 and damping-only LLG do not converge in 999 sw
   }
 }
 
-TEST_CASE("moderate field: every method converges; realigned ours is the fastest",
+TEST_CASE("moderate field: every method converges — realigned ours is the fastest",
           "[dynamics][contrast]") {
   // cluster(200): |H| ≤ 1.9 Ms. Measured sweeps to e_M ≤ 1e-6: ours 150,
   // ours-realigned 48, kim2018 533, damping-llg 242.
@@ -162,7 +162,7 @@ TEST_CASE("sub-magnetizations never collapse and keep |M_k| = Ms, for every allo
   CHECK(worst_norm <= 1e-12);
 }
 
-TEST_CASE("an overshooting Euler step would land both on H_eff; the guard keeps them apart",
+TEST_CASE("an overshooting Euler step would land both on H_eff — the guard keeps them apart",
           "[dynamics][pair]") {
   const double Ms = 1.0;
   DynamicsOptions o;

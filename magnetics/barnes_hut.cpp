@@ -1,0 +1,808 @@
+// magnetics/barnes_hut.cpp — Barnes–Hut far-field approximation of the dipole sums.
+//
+// The moments are sorted along a Morton curve and split into an octree whose leaves hold at
+// most `bh_leaf_size` moments. Every cell carries the multipole of its nonzero source moments
+// about their |m|-weighted centre c (d_i = p_i − c):
+//   M = Σ m_i (dipole), S = sym Σ d_i ⊗ m_i (quadrupole order),
+//   O = sym Σ d_i ⊗ d_i ⊗ m_i (octupole order, with bh_order = 2).
+// Targets come in groups of at most `bh_group_size` (a small subtree, or sibling subtrees
+// packed together). One walk of the tree per group lists the cells that every target of the
+// group sees under an angle below θ (b < θ (R − b_t): b the cell's radius about c, R the
+// distance from c to the group's centre, b_t the group's radius — the multipole acceptance
+// criterion) and the leaves that are near. Near leaves are summed exactly by the direct SIMD
+// kernel (field_kernel.hpp, with the self and same-group exclusions of the direct sum); far
+// cells by the Taylor expansion of eq. 1 about c,
+//   h_b(x) = Σ_i m_ia ∂_a∂_b G(r − d_i) = M_a ∂_a∂_b G − S_ac ∂_a∂_b∂_c G
+//            + ½ O_ace ∂_a∂_b∂_c∂_e G − …,     G = 1/(4π √q),  r = x − c,  q = |r|² + ε²,
+// (eq. 1 is h = ∂∂G·m; softening enters G exactly as in the direct sum), and the Jacobian
+// J = ∂h/∂x of the same series; the first omitted term is smaller than the kept ones by
+// about (b/R)^(order+1). A cell that may hold a source of a target's group gives the group
+// its field only; its Jacobian comes from deeper cells (or exactly, leaf by leaf), so
+// same-group sources stay out of J exactly. Work per group does not depend on the thread
+// that does it, so results are deterministic whatever the thread count.
+#include "magnetics/barnes_hut.hpp"
+
+#include "magnetics/field_kernel.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define MAGSIM_AVX512_KERNEL 1
+#define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
+#endif
+
+namespace magsim::mag {
+
+namespace {
+
+constexpr double kInv4Pi = 1.0 / (4.0 * kPi);
+constexpr int kMortonBits = 21;  // per axis
+
+// index of the symmetric pair (c, e) in xx, yy, zz, xy, xz, yz order
+constexpr int kPair[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+
+struct Node {
+  int child = -1;  // first child (children are contiguous); −1 = leaf
+  int nchild = 0;
+  int t0 = 0, t1 = 0;  // range of moments in tree order
+  int s0 = 0, s1 = 0;  // range of nonzero sources in the packed, tree-ordered arrays
+  double c[3] = {0, 0, 0};  // expansion centre (|m|-weighted)
+  double b = 0;             // max |p_i − c| over the sources (m)
+  double wsum = 0;          // Σ |m_i|
+  double M[3] = {0, 0, 0};  // Σ m_i
+  double Q[3][3] = {};      // Q[a][c] = Σ m_ia d_ic (full, for shifting)
+  double X[3][6] = {};      // X[a][ce] = Σ m_ia d_ic d_ie (symmetric in c, e; for shifting)
+  int gmin = std::numeric_limits<int>::max(), gmax = -1;  // groups (≥ 0) of the sources
+  std::uint64_t gmask = 0;
+};
+
+// What the list walk reads of a node (one cache line; Node holds the build-time rest).
+struct alignas(64) NodeHot {
+  double c[3];  // expansion centre
+  double b;     // radius of the sources about c
+  int child, nchild, s0, s1;
+  int gmin, gmax;
+  std::uint64_t gmask;
+};
+
+// A group of targets that share one interaction list: consecutive in tree order, within
+// one cell (a whole small subtree, or sibling subtrees packed together).
+struct Group {
+  int t0 = 0, t1 = 0;        // range of moments in tree order
+  double tc[3] = {0, 0, 0};  // bounding sphere of the targets
+  double tb = 0;
+  int tgmin = std::numeric_limits<int>::max(), tgmax = -1;  // their groups (≥ 0)
+  std::uint64_t tgmask = 0;
+};
+
+// The fields of a far cell as the kernel reads them.
+enum CellField {
+  kCx, kCy, kCz, kMx, kMy, kMz,
+  kSxx, kSyy, kSzz, kSxy, kSxz, kSyz, kTrS,                         // S and tr S
+  kOxxx, kOyyy, kOzzz, kOxxy, kOxxz, kOxyy, kOyyz, kOxzz, kOyzz, kOxyz,  // O (symmetric)
+  kTx, kTy, kTz,                                                  // t_a = O_abb
+  kCellFields
+};
+
+// Blocks of 8 cells, field by field ([block][field][lane]), so that the kernel reads every
+// field of a block at a fixed offset from one pointer.
+struct CellBuffer {
+  static constexpr std::size_t kBlock = 8 * kCellFields;
+  std::vector<double> d;  // storage (grown, never shrunk)
+  std::size_t n = 0;      // cells held
+  std::size_t size() const { return n; }
+  const double* block(std::size_t b) const { return d.data() + b * kBlock; }
+  void clear() { n = 0; }
+  void push(const double* vals) {
+    if ((n / 8 + 1) * kBlock > d.size()) d.resize(std::max<std::size_t>(8 * kBlock, 2 * d.size()));
+    double* blk = d.data() + (n / 8) * kBlock + n % 8;
+    for (int k = 0; k < kCellFields; ++k) blk[8 * k] = vals[k];
+    ++n;
+  }
+  // zero cells far away add exactly 0 (every term is linear in M, S or O)
+  void pad() {
+    double z[kCellFields] = {};
+    z[kCx] = z[kCy] = z[kCz] = detail::kPadPosition;
+    while (n % 8 != 0) push(z);
+  }
+};
+
+// Near sources gathered for one group: whole leaves copied from the tree-ordered arrays.
+struct NearBuffer {
+  std::vector<double> a[8];  // x, y, z, mx, my, mz, id, grp (grown, never shrunk)
+  std::size_t n = 0;
+  void clear() { n = 0; }
+  void reserve(std::size_t m) {
+    if (m > a[0].size())
+      for (auto& v : a) v.resize(std::max(m, 2 * a[0].size()));
+  }
+  void append(const detail::SourceBuffer& s, int s0, int s1) {
+    reserve(n + (s1 - s0) + detail::kSourcePad);
+    const std::vector<double>* src[8] = {&s.x, &s.y, &s.z, &s.mx, &s.my, &s.mz, &s.id, &s.grp};
+    for (int k = 0; k < 8; ++k) std::copy(src[k]->begin() + s0, src[k]->begin() + s1, a[k].begin() + n);
+    n += s1 - s0;
+  }
+  void pad() {
+    reserve(n + detail::kSourcePad);
+    while (n % detail::kSourcePad != 0) {
+      for (int k = 0; k < 3; ++k) a[k][n] = detail::kPadPosition;
+      for (int k = 3; k < 6; ++k) a[k][n] = 0.0;
+      a[6][n] = a[7][n] = -1.0;
+      ++n;
+    }
+  }
+  detail::SourceView view() const {
+    return detail::SourceView{a[0].data(), a[1].data(), a[2].data(), a[3].data(),
+                              a[4].data(), a[5].data(), a[6].data(), a[7].data(), n};
+  }
+};
+
+struct ThreadScratch {
+  NearBuffer near, near_j;                  // exact sources: H and J / J only
+  CellBuffer far_hj, far_h, far_j;          // cells: field and Jacobian / field only / J only
+  std::vector<std::pair<int, bool>> stack;  // (node, J-only)
+  long near_pairs = 0, far_cells = 0;       // interaction counts (statistics)
+  double lists_s = 0;                       // time spent building lists (statistics)
+};
+
+}  // namespace
+
+struct BarnesHutWorkspace {
+  std::vector<std::pair<std::uint64_t, int>> keys;  // (Morton code, moment), sorted
+  std::vector<int> order;                           // tree position → moment index
+  std::vector<int> src_prefix;                      // nonzero sources before tree position
+  std::vector<Node> nodes;
+  std::vector<NodeHot> hot;   // (nodes) the walk's view of each node
+  std::vector<double> cells;  // (nodes × kCellFields) the kernel's view of each cell
+  std::vector<Group> groups;
+  detail::SourceBuffer src;  // nonzero sources in tree order (not padded)
+  std::vector<ThreadScratch> threads;
+  BarnesHutStats stats;
+};
+
+BarnesHutWorkspace* new_barnes_hut_workspace() { return new BarnesHutWorkspace; }
+void BarnesHutWorkspaceDeleter::operator()(BarnesHutWorkspace* p) const { delete p; }
+
+BarnesHutStats barnes_hut_stats(const FieldWorkspace& ws) {
+  return ws.bh ? ws.bh->stats : BarnesHutStats{};
+}
+
+namespace {
+
+// ---- tree -------------------------------------------------------------------------------
+
+// spreads the low 21 bits of v to every third bit
+std::uint64_t spread3(std::uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+int digit(std::uint64_t code, int level) {  // octant at depth `level` (0 = root split)
+  return static_cast<int>((code >> (3 * (kMortonBits - 1 - level))) & 7);
+}
+
+void split_node(BarnesHutWorkspace* ws, int id, int level, int leaf_size) {
+  const int b = ws->nodes[id].t0, e = ws->nodes[id].t1;
+  if (e - b <= leaf_size) return;
+  // skip the levels at which every moment falls in one octant
+  while (level < kMortonBits &&
+         digit(ws->keys[b].first, level) == digit(ws->keys[e - 1].first, level))
+    ++level;
+  if (level >= kMortonBits) return;  // coincident to 21 bits: one leaf
+  int bounds[9];
+  int k = 0;
+  bounds[k++] = b;
+  for (int i = b + 1; i < e; ++i)
+    if (digit(ws->keys[i].first, level) != digit(ws->keys[i - 1].first, level)) bounds[k++] = i;
+  bounds[k] = e;
+  const int first = static_cast<int>(ws->nodes.size());
+  ws->nodes.resize(first + k);
+  ws->nodes[id].child = first;
+  ws->nodes[id].nchild = k;
+  for (int c = 0; c < k; ++c) {
+    ws->nodes[first + c].t0 = bounds[c];
+    ws->nodes[first + c].t1 = bounds[c + 1];
+  }
+  for (int c = 0; c < k; ++c) split_node(ws, first + c, level + 1, leaf_size);
+}
+
+void add_group(int g, int* gmin, int* gmax, std::uint64_t* mask) {
+  if (g < 0) return;
+  *gmin = std::min(*gmin, g);
+  *gmax = std::max(*gmax, g);
+  *mask |= std::uint64_t(1) << (g & 63);
+}
+
+// Adds a moment m at offset d from the centre to Q and X.
+void add_moment(const double* d, const double* m, Node* nd) {
+  for (int a = 0; a < 3; ++a) {
+    for (int c = 0; c < 3; ++c) nd->Q[a][c] += m[a] * d[c];
+    for (int c = 0; c < 3; ++c)
+      for (int e = c; e < 3; ++e) nd->X[a][kPair[c][e]] += m[a] * d[c] * d[e];
+  }
+}
+
+// Multipole of a leaf from its sources; of an inner node by shifting its children's:
+// with d = d' + δ (δ = c_child − c): Q_ac += Q'_ac + M'_a δ_c,
+// X_ace += X'_ace + δ_c Q'_ae + δ_e Q'_ac + δ_c δ_e M'_a.
+void node_multipole(const detail::SourceBuffer& s, BarnesHutWorkspace* ws, int id) {
+  Node& nd = ws->nodes[id];
+  double pc[3] = {0, 0, 0}, gc[3] = {0, 0, 0};
+  double w = 0;
+  if (nd.child < 0) {
+    for (int k = nd.s0; k < nd.s1; ++k) {
+      const double a = std::sqrt(s.mx[k] * s.mx[k] + s.my[k] * s.my[k] + s.mz[k] * s.mz[k]);
+      w += a;
+      pc[0] += a * s.x[k]; pc[1] += a * s.y[k]; pc[2] += a * s.z[k];
+      gc[0] += s.x[k]; gc[1] += s.y[k]; gc[2] += s.z[k];
+      add_group(static_cast<int>(s.grp[k]), &nd.gmin, &nd.gmax, &nd.gmask);
+    }
+  } else {
+    for (int c = nd.child; c < nd.child + nd.nchild; ++c) {
+      const Node& ch = ws->nodes[c];
+      w += ch.wsum;
+      for (int a = 0; a < 3; ++a) pc[a] += ch.wsum * ch.c[a];
+      nd.gmin = std::min(nd.gmin, ch.gmin);
+      nd.gmax = std::max(nd.gmax, ch.gmax);
+      nd.gmask |= ch.gmask;
+    }
+  }
+  nd.wsum = w;
+  if (nd.s1 == nd.s0) return;
+  // |m|-weighted centre (the geometric one if every |m| underflows)
+  if (w > 0) {
+    for (int a = 0; a < 3; ++a) nd.c[a] = pc[a] / w;
+  } else if (nd.child < 0) {
+    for (int a = 0; a < 3; ++a) nd.c[a] = gc[a] / (nd.s1 - nd.s0);
+  } else {
+    for (int c = nd.child; c < nd.child + nd.nchild; ++c)
+      if (ws->nodes[c].s1 > ws->nodes[c].s0) {
+        for (int a = 0; a < 3; ++a) nd.c[a] = ws->nodes[c].c[a];
+        break;
+      }
+  }
+  double b2 = 0;
+  for (int k = nd.s0; k < nd.s1; ++k) {
+    const double d[3] = {s.x[k] - nd.c[0], s.y[k] - nd.c[1], s.z[k] - nd.c[2]};
+    b2 = std::max(b2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (nd.child < 0) {
+      const double m[3] = {s.mx[k], s.my[k], s.mz[k]};
+      for (int a = 0; a < 3; ++a) nd.M[a] += m[a];
+      add_moment(d, m, &nd);
+    }
+  }
+  nd.b = std::sqrt(b2);
+  if (nd.child < 0) return;
+  for (int c = nd.child; c < nd.child + nd.nchild; ++c) {
+    const Node& ch = ws->nodes[c];
+    if (ch.s1 == ch.s0) continue;
+    const double dl[3] = {ch.c[0] - nd.c[0], ch.c[1] - nd.c[1], ch.c[2] - nd.c[2]};
+    for (int a = 0; a < 3; ++a) {
+      nd.M[a] += ch.M[a];
+      for (int cc = 0; cc < 3; ++cc) nd.Q[a][cc] += ch.Q[a][cc] + ch.M[a] * dl[cc];
+      for (int cc = 0; cc < 3; ++cc)
+        for (int e = cc; e < 3; ++e)
+          nd.X[a][kPair[cc][e]] += ch.X[a][kPair[cc][e]] + dl[cc] * ch.Q[a][e] +
+                                   dl[e] * ch.Q[a][cc] + dl[cc] * dl[e] * ch.M[a];
+    }
+  }
+}
+
+// The kernel's view of a cell: c, M, S = sym Q, tr S, O = sym X (fully symmetric), t.
+void cell_fields(const Node& nd, double* f) {
+  f[kCx] = nd.c[0]; f[kCy] = nd.c[1]; f[kCz] = nd.c[2];
+  f[kMx] = nd.M[0]; f[kMy] = nd.M[1]; f[kMz] = nd.M[2];
+  f[kSxx] = nd.Q[0][0]; f[kSyy] = nd.Q[1][1]; f[kSzz] = nd.Q[2][2];
+  f[kSxy] = 0.5 * (nd.Q[0][1] + nd.Q[1][0]);
+  f[kSxz] = 0.5 * (nd.Q[0][2] + nd.Q[2][0]);
+  f[kSyz] = 0.5 * (nd.Q[1][2] + nd.Q[2][1]);
+  f[kTrS] = f[kSxx] + f[kSyy] + f[kSzz];
+  // O_abc = (X_a,bc + X_b,ac + X_c,ab)/3
+  auto O = [&nd](int a, int b, int c) {
+    return (nd.X[a][kPair[b][c]] + nd.X[b][kPair[a][c]] + nd.X[c][kPair[a][b]]) / 3.0;
+  };
+  f[kOxxx] = O(0, 0, 0); f[kOyyy] = O(1, 1, 1); f[kOzzz] = O(2, 2, 2);
+  f[kOxxy] = O(0, 0, 1); f[kOxxz] = O(0, 0, 2); f[kOxyy] = O(0, 1, 1);
+  f[kOyyz] = O(1, 1, 2); f[kOxzz] = O(0, 2, 2); f[kOyzz] = O(1, 2, 2);
+  f[kOxyz] = O(0, 1, 2);
+  f[kTx] = f[kOxxx] + f[kOxyy] + f[kOxzz];
+  f[kTy] = f[kOxxy] + f[kOyyy] + f[kOyzz];
+  f[kTz] = f[kOxxz] + f[kOyyz] + f[kOzzz];
+}
+
+void close_group(const MomentSet& set, BarnesHutWorkspace* ws, int t0, int t1) {
+  if (t1 <= t0) return;
+  Group g;
+  g.t0 = t0;
+  g.t1 = t1;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
+  for (int t = t0; t < t1; ++t) {
+    const int i = ws->order[t];
+    lo = lo.cwiseMin(set.position[i]);
+    hi = hi.cwiseMax(set.position[i]);
+    add_group(set.group[i], &g.tgmin, &g.tgmax, &g.tgmask);
+  }
+  const Vec3 c = 0.5 * (lo + hi);
+  double b2 = 0;
+  for (int t = t0; t < t1; ++t) b2 = std::max(b2, (set.position[ws->order[t]] - c).squaredNorm());
+  for (int a = 0; a < 3; ++a) g.tc[a] = c[a];
+  g.tb = std::sqrt(b2);
+  ws->groups.push_back(g);
+}
+
+// A subtree of at most G moments is one group; below a larger node, consecutive children
+// of at most G moments each are packed together up to G.
+void make_groups(const MomentSet& set, BarnesHutWorkspace* ws, int id, int G) {
+  const Node nd = ws->nodes[id];
+  if (nd.t1 - nd.t0 <= G || nd.child < 0) {
+    close_group(set, ws, nd.t0, nd.t1);
+    return;
+  }
+  int p0 = nd.t0, p1 = nd.t0;  // pending packed range
+  for (int c = nd.child; c < nd.child + nd.nchild; ++c) {
+    const int c0 = ws->nodes[c].t0, c1 = ws->nodes[c].t1;
+    if (c1 - c0 > G) {
+      close_group(set, ws, p0, p1);
+      make_groups(set, ws, c, G);
+      p0 = p1 = c1;
+      continue;
+    }
+    if (p1 - p0 + c1 - c0 > G) {
+      close_group(set, ws, p0, p1);
+      p0 = c0;
+    }
+    p1 = c1;
+  }
+  close_group(set, ws, p0, p1);
+}
+
+void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspace* ws) {
+  const int n = static_cast<int>(set.size());
+  // Morton codes on the bounding cube, sorted (ties by index: deterministic)
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
+  for (const Vec3& p : set.position) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double side = std::max((hi - lo).maxCoeff(), 1e-300);
+  const double cells = double(1 << kMortonBits);
+  const double scale = cells / side;
+  auto quant = [cells](double x) {
+    return static_cast<std::uint64_t>(std::clamp(x, 0.0, cells - 1.0));
+  };
+  ws->keys.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 u = (set.position[i] - lo) * scale;
+    ws->keys[i] = {spread3(quant(u.x())) << 2 | spread3(quant(u.y())) << 1 | spread3(quant(u.z())), i};
+  }
+  std::sort(ws->keys.begin(), ws->keys.end());
+  ws->order.resize(n);
+  for (int i = 0; i < n; ++i) ws->order[i] = ws->keys[i].second;
+
+  // nonzero sources in tree order
+  ws->src.clear();
+  ws->src_prefix.resize(n + 1);
+  for (int t = 0; t < n; ++t) {
+    ws->src_prefix[t] = static_cast<int>(ws->src.size());
+    const int i = ws->order[t];
+    const Vec3 m = set.moment(i);
+    if (m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0) continue;
+    const Vec3& p = set.position[i];
+    ws->src.push(p.x(), p.y(), p.z(), m.x(), m.y(), m.z(), i, set.group[i]);
+  }
+  ws->src_prefix[n] = static_cast<int>(ws->src.size());
+
+  ws->nodes.assign(1, Node{});
+  ws->nodes[0].t1 = n;
+  split_node(ws, 0, 0, std::max(1, opt.bh_leaf_size));
+  // multipoles bottom-up (children have larger indices than their parent)
+  const int nn = static_cast<int>(ws->nodes.size());
+  for (int id = nn - 1; id >= 0; --id) {
+    Node& nd = ws->nodes[id];
+    nd.s0 = ws->src_prefix[nd.t0];
+    nd.s1 = ws->src_prefix[nd.t1];
+    node_multipole(ws->src, ws, id);
+  }
+  ws->cells.resize(static_cast<std::size_t>(nn) * kCellFields);
+  ws->hot.resize(nn);
+  for (int id = 0; id < nn; ++id) {
+    const Node& nd = ws->nodes[id];
+    cell_fields(nd, &ws->cells[std::size_t(id) * kCellFields]);
+    ws->hot[id] = NodeHot{{nd.c[0], nd.c[1], nd.c[2]}, nd.b, nd.child, nd.nchild, nd.s0, nd.s1,
+                          nd.gmin, nd.gmax, nd.gmask};
+  }
+  ws->groups.clear();
+  make_groups(set, ws, 0, std::max(1, opt.bh_group_size));
+}
+
+// ---- interaction lists -------------------------------------------------------------------
+
+bool groups_overlap(const NodeHot& src, const Group& g) {
+  return src.gmax >= 0 && g.tgmax >= 0 && src.gmin <= g.tgmax && g.tgmin <= src.gmax &&
+         (src.gmask & g.tgmask) != 0;
+}
+
+void gather_sources(const detail::SourceBuffer& s, const NodeHot& nd, NearBuffer* out) {
+  out->append(s, nd.s0, nd.s1);
+}
+
+// Walks the tree for one target group and fills its interaction lists (see file comment).
+void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, bool want_J,
+                 ThreadScratch* th) {
+  th->near.clear();
+  th->near_j.clear();
+  th->far_hj.clear();
+  th->far_h.clear();
+  th->far_j.clear();
+  th->stack.clear();
+  th->stack.emplace_back(0, false);
+  while (!th->stack.empty()) {
+    const auto [id, j_only] = th->stack.back();
+    th->stack.pop_back();
+    const NodeHot& nd = ws.hot[id];
+    if (nd.s1 == nd.s0) continue;
+    const double* cell = &ws.cells[std::size_t(id) * kCellFields];
+    const double dx = nd.c[0] - g.tc[0], dy = nd.c[1] - g.tc[1], dz = nd.c[2] - g.tc[2];
+    const double R = std::sqrt(dx * dx + dy * dy + dz * dz);
+    // multipole acceptance: every target of the group sees the cell under an angle < θ;
+    // the margin keeps out (despite rounding) a cell holding a target itself (b = 0 at R = b_t)
+    const bool accept = theta > 0 && R * (1.0 - 1e-12) > g.tb + nd.b && nd.b < theta * (R - g.tb);
+    const bool overlap = want_J && groups_overlap(nd, g);
+    if (accept) {
+      if (!want_J) {
+        th->far_h.push(cell);
+        continue;
+      }
+      if (!overlap) {
+        (j_only ? th->far_j : th->far_hj).push(cell);
+        continue;
+      }
+      // the cell may hold sources of the group's own rigid bodies: its field from the
+      // expansion, its Jacobian from deeper down
+      if (!j_only) th->far_h.push(cell);
+    }
+    if (nd.child < 0) {
+      gather_sources(ws.src, nd, (accept || j_only) ? &th->near_j : &th->near);
+      continue;
+    }
+    const bool child_j_only = j_only || accept;
+    for (int c = nd.child + nd.nchild - 1; c >= nd.child; --c) th->stack.emplace_back(c, child_j_only);
+  }
+  th->near.pad();
+  th->near_j.pad();
+  th->far_hj.pad();
+  th->far_h.pad();
+  th->far_j.pad();
+}
+
+// ---- far-cell kernel ---------------------------------------------------------------------
+//
+// The series of the file comment, written out (u_n = q^{-n/2}, ρ = r·M − tr S, w = S r,
+// s = rᵀ S r; with order 2 also o1 = O·r (matrix), o2 = O:rr, o3 = O⋮rrr, τ = t·r,
+// t_a = O_abb):
+//   A   = 3ρ u5 + (15 s − 22.5 τ) u7 + 52.5 o3 u9
+//   4π h = A r − u3 M + u5 (4.5 t − 6 w) − 22.5 u7 o2
+//   c_r = −7.5 ρ u7 + (78.75 τ − 52.5 s) u9 − 236.25 o3 u11
+//   K   = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
+//   4π J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1
+// With order 1 every O term is dropped (τ = o3 = 0, t = o1 = o2 = 0).
+
+template <bool kH, bool kJ, int kOrder>
+void far_portable(const CellBuffer& cb, const double* p, double eps2, double* Hout,
+                  double* Jout) {
+  double hx = 0, hy = 0, hz = 0;
+  double ja = 0, jxx = 0, jyy = 0, jzz = 0, jxy = 0, jxz = 0, jyz = 0;
+  const std::size_t nb = cb.size() / 8;
+  for (std::size_t blk = 0; blk < nb; ++blk) {
+  const double* B = cb.block(blk);
+  const double *cx = B + 8 * kCx, *cy = B + 8 * kCy, *cz = B + 8 * kCz, *Mx = B + 8 * kMx,
+               *My = B + 8 * kMy, *Mz = B + 8 * kMz, *Sxx = B + 8 * kSxx, *Syy = B + 8 * kSyy,
+               *Szz = B + 8 * kSzz, *Sxy = B + 8 * kSxy, *Sxz = B + 8 * kSxz,
+               *Syz = B + 8 * kSyz, *trS = B + 8 * kTrS, *Oxxx = B + 8 * kOxxx,
+               *Oyyy = B + 8 * kOyyy, *Ozzz = B + 8 * kOzzz, *Oxxy = B + 8 * kOxxy,
+               *Oxxz = B + 8 * kOxxz, *Oxyy = B + 8 * kOxyy, *Oyyz = B + 8 * kOyyz,
+               *Oxzz = B + 8 * kOxzz, *Oyzz = B + 8 * kOyzz, *Oxyz = B + 8 * kOxyz,
+               *Tx = B + 8 * kTx, *Ty = B + 8 * kTy, *Tz = B + 8 * kTz;
+#pragma omp simd reduction(+ : hx, hy, hz, ja, jxx, jyy, jzz, jxy, jxz, jyz)
+  for (std::size_t i = 0; i < 8; ++i) {
+    const double rx = p[0] - cx[i], ry = p[1] - cy[i], rz = p[2] - cz[i];
+    const double q = rx * rx + ry * ry + rz * rz + eps2;
+    const double u = 1.0 / std::sqrt(q);
+    const double u2 = u * u, u3 = u2 * u, u5 = u3 * u2, u7 = u5 * u2, u9 = u7 * u2,
+                 u11 = u9 * u2;
+    const double wx = Sxx[i] * rx + Sxy[i] * ry + Sxz[i] * rz;
+    const double wy = Sxy[i] * rx + Syy[i] * ry + Syz[i] * rz;
+    const double wz = Sxz[i] * rx + Syz[i] * ry + Szz[i] * rz;
+    const double s = rx * wx + ry * wy + rz * wz;
+    const double rho = rx * Mx[i] + ry * My[i] + rz * Mz[i] - trS[i];
+    double oxx = 0, oyy = 0, ozz = 0, oxy = 0, oxz = 0, oyz = 0;  // o1
+    double o2x = 0, o2y = 0, o2z = 0, o3 = 0, tau = 0, tx = 0, ty = 0, tz = 0;
+    if constexpr (kOrder >= 2) {
+      oxx = Oxxx[i] * rx + Oxxy[i] * ry + Oxxz[i] * rz;
+      oyy = Oxyy[i] * rx + Oyyy[i] * ry + Oyyz[i] * rz;
+      ozz = Oxzz[i] * rx + Oyzz[i] * ry + Ozzz[i] * rz;
+      oxy = Oxxy[i] * rx + Oxyy[i] * ry + Oxyz[i] * rz;
+      oxz = Oxxz[i] * rx + Oxyz[i] * ry + Oxzz[i] * rz;
+      oyz = Oxyz[i] * rx + Oyyz[i] * ry + Oyzz[i] * rz;
+      o2x = oxx * rx + oxy * ry + oxz * rz;
+      o2y = oxy * rx + oyy * ry + oyz * rz;
+      o2z = oxz * rx + oyz * ry + ozz * rz;
+      o3 = o2x * rx + o2y * ry + o2z * rz;
+      tx = Tx[i]; ty = Ty[i]; tz = Tz[i];
+      tau = tx * rx + ty * ry + tz * rz;
+    }
+    const double A = 3.0 * rho * u5 + (15.0 * s - 22.5 * tau) * u7 + 52.5 * o3 * u9;
+    if constexpr (kH) {
+      hx += A * rx - u3 * Mx[i] + u5 * (4.5 * tx - 6.0 * wx) - 22.5 * u7 * o2x;
+      hy += A * ry - u3 * My[i] + u5 * (4.5 * ty - 6.0 * wy) - 22.5 * u7 * o2y;
+      hz += A * rz - u3 * Mz[i] + u5 * (4.5 * tz - 6.0 * wz) - 22.5 * u7 * o2z;
+    }
+    if constexpr (kJ) {
+      const double cr = -7.5 * rho * u7 + (78.75 * tau - 52.5 * s) * u9 - 236.25 * o3 * u11;
+      const double Kx = 3.0 * u5 * Mx[i] + u7 * (30.0 * wx - 22.5 * tx) + 157.5 * u9 * o2x + cr * rx;
+      const double Ky = 3.0 * u5 * My[i] + u7 * (30.0 * wy - 22.5 * ty) + 157.5 * u9 * o2y + cr * ry;
+      const double Kz = 3.0 * u5 * Mz[i] + u7 * (30.0 * wz - 22.5 * tz) + 157.5 * u9 * o2z + cr * rz;
+      ja += A;
+      jxx += 2.0 * rx * Kx - 6.0 * u5 * Sxx[i] - 45.0 * u7 * oxx;
+      jyy += 2.0 * ry * Ky - 6.0 * u5 * Syy[i] - 45.0 * u7 * oyy;
+      jzz += 2.0 * rz * Kz - 6.0 * u5 * Szz[i] - 45.0 * u7 * ozz;
+      jxy += rx * Ky + ry * Kx - 6.0 * u5 * Sxy[i] - 45.0 * u7 * oxy;
+      jxz += rx * Kz + rz * Kx - 6.0 * u5 * Sxz[i] - 45.0 * u7 * oxz;
+      jyz += ry * Kz + rz * Ky - 6.0 * u5 * Syz[i] - 45.0 * u7 * oyz;
+    }
+  }
+  }
+  if constexpr (kH) {
+    Hout[0] += hx * kInv4Pi; Hout[1] += hy * kInv4Pi; Hout[2] += hz * kInv4Pi;
+  }
+  if constexpr (kJ) {
+    Jout[0] += (ja + jxx) * kInv4Pi; Jout[1] += (ja + jyy) * kInv4Pi;
+    Jout[2] += (ja + jzz) * kInv4Pi;
+    Jout[3] += jxy * kInv4Pi; Jout[4] += jxz * kInv4Pi; Jout[5] += jyz * kInv4Pi;
+  }
+}
+
+#ifdef MAGSIM_AVX512_KERNEL
+
+using V8 = __m512d;
+MAGSIM_TARGET_AVX512 inline V8 set1(double x) { return _mm512_set1_pd(x); }
+MAGSIM_TARGET_AVX512 inline V8 ld(const double* p) { return _mm512_loadu_pd(p); }
+MAGSIM_TARGET_AVX512 inline V8 add(V8 a, V8 b) { return _mm512_add_pd(a, b); }
+MAGSIM_TARGET_AVX512 inline V8 sub(V8 a, V8 b) { return _mm512_sub_pd(a, b); }
+MAGSIM_TARGET_AVX512 inline V8 mul(V8 a, V8 b) { return _mm512_mul_pd(a, b); }
+MAGSIM_TARGET_AVX512 inline V8 fma(V8 a, V8 b, V8 c) { return _mm512_fmadd_pd(a, b, c); }
+MAGSIM_TARGET_AVX512 inline V8 fnma(V8 a, V8 b, V8 c) { return _mm512_fnmadd_pd(a, b, c); }
+// a·x + b·y + c·z
+MAGSIM_TARGET_AVX512 inline V8 dot3(V8 a, V8 b, V8 c, V8 x, V8 y, V8 z) {
+  return fma(c, z, fma(b, y, mul(a, x)));
+}
+
+// 1/√q, as in dipole_field.cpp (vrsqrt14pd and one fourth-order step, error < 1e-16)
+MAGSIM_TARGET_AVX512 inline V8 rsqrt_pd(V8 q) {
+  const V8 y = _mm512_maskz_rsqrt14_pd(0xff, q);
+  const V8 e = fnma(q, mul(y, y), set1(1.0));
+  const V8 p = fma(fma(set1(5.0 / 16.0), e, set1(3.0 / 8.0)), e, set1(0.5));
+  return fma(mul(y, e), p, y);
+}
+
+MAGSIM_TARGET_AVX512 inline double hsum(V8 v) {
+  alignas(64) double t[8];
+  _mm512_store_pd(t, v);
+  return ((t[0] + t[4]) + (t[1] + t[5])) + ((t[2] + t[6]) + (t[3] + t[7]));
+}
+
+template <bool kH, bool kJ, int kOrder>
+MAGSIM_TARGET_AVX512 void far_avx512(const CellBuffer& cb, const double* p, double eps2,
+                                     double* Hout, double* Jout) {
+  const V8 px = set1(p[0]), py = set1(p[1]), pz = set1(p[2]), e2 = set1(eps2);
+  const V8 zero = _mm512_setzero_pd();
+  V8 hx = zero, hy = zero, hz = zero;
+  V8 ja = zero, jxx = zero, jyy = zero, jzz = zero, jxy = zero, jxz = zero, jyz = zero;
+  const std::size_t nb = cb.size() / 8;
+  for (std::size_t blk = 0; blk < nb; ++blk) {
+    const double* B = cb.block(blk);
+    const V8 rx = sub(px, ld(B + 8 * kCx)), ry = sub(py, ld(B + 8 * kCy)), rz = sub(pz, ld(B + 8 * kCz));
+    const V8 q = fma(rz, rz, fma(ry, ry, fma(rx, rx, e2)));
+    const V8 u = rsqrt_pd(q);
+    const V8 u2 = mul(u, u), u3 = mul(u2, u), u5 = mul(u3, u2), u7 = mul(u5, u2);
+    const V8 Sxx = ld(B + 8 * kSxx), Syy = ld(B + 8 * kSyy), Szz = ld(B + 8 * kSzz), Sxy = ld(B + 8 * kSxy), Sxz = ld(B + 8 * kSxz),
+             Syz = ld(B + 8 * kSyz);
+    const V8 Mx = ld(B + 8 * kMx), My = ld(B + 8 * kMy), Mz = ld(B + 8 * kMz);
+    const V8 wx = dot3(Sxx, Sxy, Sxz, rx, ry, rz);
+    const V8 wy = dot3(Sxy, Syy, Syz, rx, ry, rz);
+    const V8 wz = dot3(Sxz, Syz, Szz, rx, ry, rz);
+    const V8 s = dot3(rx, ry, rz, wx, wy, wz);
+    const V8 rho = sub(dot3(rx, ry, rz, Mx, My, Mz), ld(B + 8 * kTrS));
+    V8 oxx = zero, oyy = zero, ozz = zero, oxy = zero, oxz = zero, oyz = zero;
+    V8 o2x = zero, o2y = zero, o2z = zero, o3 = zero, tau = zero, tx = zero, ty = zero,
+       tz = zero, u9 = zero;
+    V8 A = fma(mul(set1(3.0), rho), u5, mul(mul(set1(15.0), s), u7));
+    if constexpr (kOrder >= 2) {
+      const V8 Oxxy = ld(B + 8 * kOxxy), Oxxz = ld(B + 8 * kOxxz), Oxyy = ld(B + 8 * kOxyy), Oyyz = ld(B + 8 * kOyyz),
+               Oxzz = ld(B + 8 * kOxzz), Oyzz = ld(B + 8 * kOyzz), Oxyz = ld(B + 8 * kOxyz);
+      oxx = dot3(ld(B + 8 * kOxxx), Oxxy, Oxxz, rx, ry, rz);
+      oyy = dot3(Oxyy, ld(B + 8 * kOyyy), Oyyz, rx, ry, rz);
+      ozz = dot3(Oxzz, Oyzz, ld(B + 8 * kOzzz), rx, ry, rz);
+      oxy = dot3(Oxxy, Oxyy, Oxyz, rx, ry, rz);
+      oxz = dot3(Oxxz, Oxyz, Oxzz, rx, ry, rz);
+      oyz = dot3(Oxyz, Oyyz, Oyzz, rx, ry, rz);
+      o2x = dot3(oxx, oxy, oxz, rx, ry, rz);
+      o2y = dot3(oxy, oyy, oyz, rx, ry, rz);
+      o2z = dot3(oxz, oyz, ozz, rx, ry, rz);
+      o3 = dot3(o2x, o2y, o2z, rx, ry, rz);
+      tx = ld(B + 8 * kTx); ty = ld(B + 8 * kTy); tz = ld(B + 8 * kTz);
+      tau = dot3(tx, ty, tz, rx, ry, rz);
+      u9 = mul(u7, u2);
+      A = fma(mul(set1(52.5), o3), u9, fnma(mul(set1(22.5), tau), u7, A));
+    }
+    if constexpr (kH) {
+      // h = A r − u3 M − u5 v − 22.5 u7 o2,  v = 6 w − 4.5 t
+      const V8 c6 = set1(6.0);
+      V8 vx = mul(c6, wx), vy = mul(c6, wy), vz = mul(c6, wz);
+      if constexpr (kOrder >= 2) {
+        const V8 c45 = set1(4.5), u7_225 = mul(set1(22.5), u7);
+        vx = fnma(c45, tx, vx);
+        vy = fnma(c45, ty, vy);
+        vz = fnma(c45, tz, vz);
+        hx = fnma(u7_225, o2x, hx);
+        hy = fnma(u7_225, o2y, hy);
+        hz = fnma(u7_225, o2z, hz);
+      }
+      hx = fnma(u3, Mx, fnma(u5, vx, fma(A, rx, hx)));
+      hy = fnma(u3, My, fnma(u5, vy, fma(A, ry, hy)));
+      hz = fnma(u3, Mz, fnma(u5, vz, fma(A, rz, hz)));
+    }
+    if constexpr (kJ) {
+      // K = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
+      if constexpr (kOrder < 2) u9 = mul(u7, u2);
+      V8 cr = fnma(mul(set1(7.5), rho), u7, mul(mul(set1(-52.5), s), u9));
+      const V8 u5_3m = mul(set1(3.0), u5), u7_30 = mul(set1(30.0), u7);
+      V8 Kx = fma(u7_30, wx, mul(u5_3m, Mx));
+      V8 Ky = fma(u7_30, wy, mul(u5_3m, My));
+      V8 Kz = fma(u7_30, wz, mul(u5_3m, Mz));
+      if constexpr (kOrder >= 2) {
+        const V8 u11 = mul(u9, u2);
+        cr = fnma(mul(set1(236.25), o3), u11, fma(mul(set1(78.75), tau), u9, cr));
+        const V8 u7_225 = mul(set1(22.5), u7), u9_1575 = mul(set1(157.5), u9);
+        Kx = fma(u9_1575, o2x, fnma(u7_225, tx, Kx));
+        Ky = fma(u9_1575, o2y, fnma(u7_225, ty, Ky));
+        Kz = fma(u9_1575, o2z, fnma(u7_225, tz, Kz));
+      }
+      Kx = fma(cr, rx, Kx);
+      Ky = fma(cr, ry, Ky);
+      Kz = fma(cr, rz, Kz);
+      // J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1; the diagonal sums hold half of their
+      // r K, S and o1 terms (doubled at the end)
+      const V8 u5_3 = mul(set1(3.0), u5), u5_6 = mul(set1(6.0), u5);
+      ja = add(ja, A);
+      V8 dxx = fnma(u5_3, Sxx, mul(rx, Kx)), dyy = fnma(u5_3, Syy, mul(ry, Ky)),
+         dzz = fnma(u5_3, Szz, mul(rz, Kz));
+      V8 dxy = fnma(u5_6, Sxy, fma(ry, Kx, mul(rx, Ky)));
+      V8 dxz = fnma(u5_6, Sxz, fma(rz, Kx, mul(rx, Kz)));
+      V8 dyz = fnma(u5_6, Syz, fma(rz, Ky, mul(ry, Kz)));
+      if constexpr (kOrder >= 2) {
+        const V8 u7_225 = mul(set1(22.5), u7), u7_45 = mul(set1(45.0), u7);
+        dxx = fnma(u7_225, oxx, dxx);
+        dyy = fnma(u7_225, oyy, dyy);
+        dzz = fnma(u7_225, ozz, dzz);
+        dxy = fnma(u7_45, oxy, dxy);
+        dxz = fnma(u7_45, oxz, dxz);
+        dyz = fnma(u7_45, oyz, dyz);
+      }
+      jxx = add(jxx, dxx); jyy = add(jyy, dyy); jzz = add(jzz, dzz);
+      jxy = add(jxy, dxy); jxz = add(jxz, dxz); jyz = add(jyz, dyz);
+    }
+  }
+  if constexpr (kH) {
+    Hout[0] += hsum(hx) * kInv4Pi; Hout[1] += hsum(hy) * kInv4Pi; Hout[2] += hsum(hz) * kInv4Pi;
+  }
+  if constexpr (kJ) {
+    const double a = hsum(ja);
+    Jout[0] += (a + 2.0 * hsum(jxx)) * kInv4Pi; Jout[1] += (a + 2.0 * hsum(jyy)) * kInv4Pi;
+    Jout[2] += (a + 2.0 * hsum(jzz)) * kInv4Pi;
+    Jout[3] += hsum(jxy) * kInv4Pi; Jout[4] += hsum(jxz) * kInv4Pi; Jout[5] += hsum(jyz) * kInv4Pi;
+  }
+}
+
+#endif  // MAGSIM_AVX512_KERNEL
+
+template <bool kH, bool kJ>
+void far_sum(const CellBuffer& cb, int order, const double* p, double eps2, double* H,
+             double* J) {
+  if (cb.size() == 0) return;
+#ifdef MAGSIM_AVX512_KERNEL
+  if (detail::simd_kernel_active()) {
+    if (order >= 2) far_avx512<kH, kJ, 2>(cb, p, eps2, H, J);
+    else far_avx512<kH, kJ, 1>(cb, p, eps2, H, J);
+    return;
+  }
+#endif
+  if (order >= 2) far_portable<kH, kJ, 2>(cb, p, eps2, H, J);
+  else far_portable<kH, kJ, 1>(cb, p, eps2, H, J);
+}
+
+}  // namespace
+
+void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
+                       std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const int n = static_cast<int>(set.size());
+  H->resize(n);
+  if (J) J->resize(n);
+  ws->stats = BarnesHutStats{};
+  if (n == 0) return;
+  build_tree(set, opt, ws);
+  const auto t_built = std::chrono::steady_clock::now();
+  const double eps2 = opt.softening * opt.softening;
+  const bool want_J = J != nullptr;
+  const int order = opt.bh_order;
+  const int nthreads = omp_get_max_threads();
+  if (static_cast<int>(ws->threads.size()) < nthreads) ws->threads.resize(nthreads);
+  for (ThreadScratch& th : ws->threads) {
+    th.near_pairs = th.far_cells = 0;
+    th.lists_s = 0;
+  }
+  const long ngroups = static_cast<long>(ws->groups.size());
+#pragma omp parallel
+  {
+    ThreadScratch& th = ws->threads[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 1)
+    for (long l = 0; l < ngroups; ++l) {
+      const Group& g = ws->groups[l];
+      const auto t_l0 = std::chrono::steady_clock::now();
+      build_lists(*ws, g, opt.bh_theta, want_J, &th);
+      th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
+      const detail::SourceView vn = th.near.view(), vj = th.near_j.view();
+      const long nt = g.t1 - g.t0;
+      th.near_pairs += nt * static_cast<long>(vn.n + vj.n);
+      th.far_cells += nt * static_cast<long>(th.far_hj.size() + th.far_h.size() + th.far_j.size());
+      for (int t = g.t0; t < g.t1; ++t) {
+        const int i = ws->order[t];
+        const Vec3& p = set.position[i];
+        const double grp = set.group[i] >= 0 ? static_cast<double>(set.group[i])
+                                             : std::numeric_limits<double>::quiet_NaN();
+        const detail::Target tg{p.x(), p.y(), p.z(), static_cast<double>(i), grp};
+        const double pp[3] = {p.x(), p.y(), p.z()};
+        double h[3] = {0, 0, 0}, jac[6] = {0, 0, 0, 0, 0, 0}, unused[3] = {0, 0, 0};
+        detail::sum_pairs(vn, tg, eps2, want_J ? detail::PairTerms::HJ : detail::PairTerms::H, h, jac);
+        if (want_J) {
+          detail::sum_pairs(vj, tg, eps2, detail::PairTerms::HJ, unused, jac);
+          far_sum<true, true>(th.far_hj, order, pp, eps2, h, jac);
+          far_sum<false, true>(th.far_j, order, pp, eps2, h, jac);
+        }
+        far_sum<true, false>(th.far_h, order, pp, eps2, h, jac);
+        (*H)[i] = set.H0 + Vec3(h[0], h[1], h[2]);
+        if (want_J) {
+          (*J)[i] << jac[0], jac[3], jac[4],
+                     jac[3], jac[1], jac[5],
+                     jac[4], jac[5], jac[2];
+        }
+      }
+    }
+  }
+  const auto t_end = std::chrono::steady_clock::now();
+  BarnesHutStats& st = ws->stats;
+  st.nodes = static_cast<int>(ws->nodes.size());
+  st.groups = static_cast<int>(ngroups);
+  for (const ThreadScratch& th : ws->threads) {
+    st.near_pairs_per_target += double(th.near_pairs) / n;
+    st.far_cells_per_target += double(th.far_cells) / n;
+    st.lists_s += th.lists_s;
+  }
+  st.build_s = std::chrono::duration<double>(t_built - t_start).count();
+  st.eval_s = std::chrono::duration<double>(t_end - t_built).count();
+}
+
+}  // namespace magsim::mag

@@ -1,0 +1,66 @@
+// tests/stability/run_scene.hpp — runs a registry scene and keeps what the stability tests
+// measure: the metrics series and their maxima over a trailing window.
+#pragma once
+
+#include "engine/simulation.hpp"
+#include "scenes/registry.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace magsim::test {
+
+struct SceneRun {
+  engine::Metrics last;
+  double tail_max_speed = 0;     ///< max body speed over the trailing window (m/s)
+  double tail_max_ke = 0;        ///< max kinetic energy over the trailing window (J)
+  double max_speed = 0;          ///< over the whole run (m/s)
+  double max_bounding_radius = 0;
+  int min_attached_tail = 1 << 30;
+  double cap_fraction = 0;       ///< steps whose magnetization hit the cap
+  bool failed = false;           ///< SimulationError
+  std::string error;
+  std::uint64_t hash = 0;
+};
+
+/// Runs `name` for `seconds` with `method`; the trailing window is the last `tail` seconds.
+inline SceneRun run_scene(const std::string& name, mag::Method method, double seconds,
+                          double tail, int count = 0, double strength = 1.0,
+                          double dt_m = 0.0) {
+  scenes::SceneParams p;
+  p.count = count;
+  p.strength = strength;
+  engine::SceneDesc d = scenes::find_scene(name)->build(p);
+  d.options.method = method;
+  if (dt_m > 0) d.options.magnetics.dt = dt_m;
+  engine::Simulation sim(d);
+  SceneRun r;
+  const long n = static_cast<long>(seconds / d.options.dt + 0.5);
+  const long tail_from = n - static_cast<long>(tail / d.options.dt + 0.5);
+  long caps = 0;
+  try {
+    for (long k = 1; k <= n; ++k) {
+      sim.step();
+      caps += sim.last_profile().cap_hit;
+      if (k % 5 != 0 && k != n) continue;
+      const engine::Metrics m = sim.metrics();
+      r.max_speed = std::max(r.max_speed, m.max_speed);
+      r.max_bounding_radius = std::max(r.max_bounding_radius, m.bounding_radius);
+      if (k >= tail_from) {
+        r.tail_max_speed = std::max(r.tail_max_speed, m.max_speed);
+        r.tail_max_ke = std::max(r.tail_max_ke, m.kinetic_energy);
+        r.min_attached_tail = std::min(r.min_attached_tail, m.attached);
+      }
+    }
+  } catch (const engine::SimulationError& e) {
+    r.failed = true;
+    r.error = e.what();
+  }
+  r.last = sim.metrics();
+  r.cap_fraction = static_cast<double>(caps) / std::max(1L, sim.steps());
+  r.hash = sim.state_hash();
+  return r;
+}
+
+}  // namespace magsim::test

@@ -1,0 +1,344 @@
+// tools/bench_kernel.cpp — speed (and, for Barnes–Hut, accuracy) of the dipole-field
+// kernel of magnetics/dipole_field.cpp: pair evaluations per second of the direct sum (field
+// only, and field + Jacobian), single- and multi-threaded, and the Barnes–Hut approximation
+// (magnetics/barnes_hut.cpp) at several opening angles θ: time, speed-up over the direct sum,
+// effective pairs/s = N²/time, and its relative field (and Jacobian) error against the
+// direct sum (max over targets of |ΔH_j|/|H_j|, and RMS = √(Σ|ΔH_j|²/Σ|H_j|²)). Medians over
+// repeats (wall clock). Above --full-max moments the direct sum is timed on --sample evenly
+// spaced targets and extrapolated to all N (printed as "sampled"), and Barnes–Hut is checked
+// on those targets. Never a pass/fail test: timings depend on the machine and its load.
+//
+// Moments: iron balls (radius 4 mm, Ms = 1.6 MA/m) in two layouts — "pile", a packed heap
+// (an FCC packing of touching balls filled layer by layer on a square footprint, about three
+// times as wide as high, like the scenes' piles) and "cloud", a uniform random cloud at 5 %
+// volume fraction. Magnetized as a scene would be (--moments scene, the default: a strong
+// magnet above the middle, each ball at f(H_magnet + H0)) or independently at random
+// (--moments random, the hard case for multipoles).
+#include "magnetics/barnes_hut.hpp"
+#include "magnetics/curves.hpp"
+#include "magnetics/field_kernel.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <unordered_map>
+
+namespace mag = magsim::mag;
+using mag::Mat3;
+using mag::Vec3;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kRadius = 4e-3;  // m
+constexpr double kMs = 1.6e6;     // A/m (iron)
+double ball_volume() { return 4.0 / 3.0 * mag::kPi * kRadius * kRadius * kRadius; }
+
+// "scene": a strong permanent magnet (a 2 cm cube of NdFeB, m = 1.2e6 A/m × 8e-6 m³) sits
+// 2 cm above the middle of the top; each ball takes M = f(H_magnet + H0) (eq. 10, the first
+// sweep of a solve) with a weak uniform H0 = 0.01 Ms ẑ, times a ±10 % per-ball jitter — smooth
+// like a relaxed scene. "random": |M| ∈ [0.05, 0.6] Ms uniform, directions within ~35° of z,
+// independently per ball, no magnet — the hard case for any multipole expansion.
+void magnetize(mag::MomentSet* s, std::mt19937* rng, bool scene) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> x(0.05, 0.6), jit(0.9, 1.1);
+  if (!scene) {
+    for (std::size_t j = 0; j < s->size(); ++j) {
+      const Vec3 u = (Vec3::UnitZ() + 0.6 * Vec3(g(*rng), g(*rng), g(*rng))).normalized();
+      s->set_magnetization(j, x(*rng) * kMs * u);
+    }
+    return;
+  }
+  Vec3 lo = s->position[0], hi = lo;
+  for (const Vec3& p : s->position) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Vec3 pm(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), hi.z() + 0.02);
+  const Vec3 mm(0, 0, -1.2e6 * 8e-6);
+  const Vec3 H0(0, 0, 0.01 * kMs);
+  const std::size_t n = s->size();
+  for (std::size_t j = 0; j < n; ++j) {
+    const Vec3 H = H0 + mag::dipole_field(s->position[j] - pm, mm);
+    s->set_magnetization(j, jit(*rng) * mag::curve_M(mag::Curve::Tanh, H, kMs));
+  }
+  s->add_permanent(pm, 8e-6, mm);
+  s->H0 = H0;
+}
+
+// FCC lattice of touching balls, filled layer by layer over a square footprint.
+mag::MomentSet pile(int n, unsigned seed, bool scene) {
+  const double d = 2.0 * kRadius * 1.001;  // nearest-neighbour distance
+  const double a = d * std::sqrt(2.0);     // cubic cell
+  // footprint side W with height ≈ W/3 at packing fraction 0.74
+  const double W = std::cbrt(3.0 * n * ball_volume() / 0.74);
+  const int nxy = static_cast<int>(std::ceil(W / a));
+  std::vector<Vec3> pts;
+  for (int k = 0; static_cast<int>(pts.size()) < n; ++k) {
+    // one cubic layer at a time (two atomic layers), sorted by height
+    std::vector<Vec3> layer;
+    for (int i = 0; i < nxy; ++i)
+      for (int j = 0; j < nxy; ++j) {
+        const Vec3 o(i * a, j * a, k * a);
+        for (const Vec3& b : {Vec3(0, 0, 0), Vec3(0.5, 0.5, 0), Vec3(0.5, 0, 0.5), Vec3(0, 0.5, 0.5)})
+          layer.push_back(o + a * b);
+      }
+    std::stable_sort(layer.begin(), layer.end(),
+                     [](const Vec3& p, const Vec3& q) { return p.z() < q.z(); });
+    for (const Vec3& p : layer)
+      if (static_cast<int>(pts.size()) < n) pts.push_back(p);
+  }
+  mag::MomentSet s;
+  for (const Vec3& p : pts) s.add_induced(p, ball_volume(), kMs);
+  std::mt19937 rng(seed);
+  magnetize(&s, &rng, scene);
+  return s;
+}
+
+// Uniform random balls at 5 % volume fraction, no two overlapping (grid-hashed rejection).
+mag::MomentSet cloud(int n, unsigned seed, bool scene) {
+  const double L = std::cbrt(n * ball_volume() / 0.05);
+  const double cell = 2.0 * kRadius;
+  const int nc = std::max(1, static_cast<int>(L / cell));
+  std::unordered_map<long, std::vector<int>> grid;
+  auto key = [&](int i, int j, int k) { return (static_cast<long>(i) * nc + j) * nc + k; };
+  auto cell_of = [&](double v) { return std::clamp(static_cast<int>(v / L * nc), 0, nc - 1); };
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, L);
+  std::vector<Vec3> pts;
+  while (static_cast<int>(pts.size()) < n) {
+    const Vec3 p(u(rng), u(rng), u(rng));
+    const int ci = cell_of(p.x()), cj = cell_of(p.y()), ck = cell_of(p.z());
+    bool ok = true;
+    for (int di = -1; di <= 1 && ok; ++di)
+      for (int dj = -1; dj <= 1 && ok; ++dj)
+        for (int dk = -1; dk <= 1 && ok; ++dk) {
+          auto it = grid.find(key(ci + di, cj + dj, ck + dk));
+          if (it == grid.end()) continue;
+          for (int q : it->second) ok = ok && (pts[q] - p).norm() >= 2.0 * kRadius;
+        }
+    if (!ok) continue;
+    grid[key(ci, cj, ck)].push_back(static_cast<int>(pts.size()));
+    pts.push_back(p);
+  }
+  mag::MomentSet s;
+  for (const Vec3& p : pts) s.add_induced(p, ball_volume(), kMs);
+  magnetize(&s, &rng, scene);
+  return s;
+}
+
+bool g_use_min = false;  // --stat min: the fastest repeat instead of the median
+bool g_cpu_clock = false;  // --clock cpu: process CPU time instead of wall time
+
+double now_s() {
+  if (g_cpu_clock) {
+    timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+  }
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+template <class F>
+double median_seconds(int repeat, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < repeat; ++r) {
+    const double t0 = now_s();
+    f();
+    t.push_back(now_s() - t0);
+  }
+  std::sort(t.begin(), t.end());
+  return g_use_min ? t.front() : t[t.size() / 2];
+}
+
+struct Errors {
+  double h_max = 0, h_rms = 0, j_max = 0, j_rms = 0;
+};
+
+// max_j |ΔH_j|/|H_j| and √(Σ|ΔH_j|² / Σ|H_j|²) over the sampled targets (and for J, Frobenius)
+Errors errors(const std::vector<int>& sample, const std::vector<Vec3>& H, const std::vector<Mat3>* J,
+              const std::vector<Vec3>& Href, const std::vector<Mat3>* Jref) {
+  Errors e;
+  double hn = 0, hd = 0, jn = 0, jd = 0;
+  for (std::size_t k = 0; k < sample.size(); ++k) {
+    const int i = sample[k];
+    const double dh = (H[i] - Href[k]).norm(), rh = Href[k].norm();
+    e.h_max = std::max(e.h_max, rh > 0 ? dh / rh : dh);
+    hn += dh * dh;
+    hd += rh * rh;
+    if (J && Jref) {
+      const double dj = ((*J)[i] - (*Jref)[k]).norm(), rj = (*Jref)[k].norm();
+      e.j_max = std::max(e.j_max, rj > 0 ? dj / rj : dj);
+      jn += dj * dj;
+      jd += rj * rj;
+    }
+  }
+  e.h_rms = hd > 0 ? std::sqrt(hn / hd) : 0;
+  e.j_rms = jd > 0 ? std::sqrt(jn / jd) : 0;
+  return e;
+}
+
+std::vector<int> sample_targets(int n, int k) {
+  std::vector<int> s;
+  if (k >= n) {
+    for (int i = 0; i < n; ++i) s.push_back(i);
+    return s;
+  }
+  for (int i = 0; i < k; ++i) s.push_back(static_cast<int>((static_cast<long>(i) * n) / k));
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench_kernel — pair evaluations per second of the dipole-field kernel, and "
+               "Barnes–Hut speed and accuracy against the direct sum"};
+  std::vector<int> sizes{1000, 2500, 10000, 100000};
+  std::vector<int> threads{1, 2};
+  std::vector<double> thetas{0.3, 0.5, 0.7};
+  std::vector<std::string> layouts{"pile", "cloud"};
+  std::string json_path, moments = "scene";
+  int repeat = 3, sample = 2048, full_max = 20000, leaf = 64, group = 32, order = 2;
+  bool portable = false, no_bh = false;
+  app.add_option("--sizes", sizes, "numbers of moments")->delimiter(',');
+  app.add_option("--threads", threads, "thread counts")->delimiter(',');
+  app.add_option("--theta", thetas, "Barnes–Hut opening angles θ")->delimiter(',');
+  app.add_option("--layouts", layouts, "pile, cloud")->delimiter(',');
+  app.add_option("--moments", moments, "scene (smooth, a magnet above) or random")
+      ->check(CLI::IsMember({"scene", "random"}));
+  app.add_option("--json", json_path, "write the results as JSON to this file");
+  app.add_option("--repeat", repeat, "timed repeats per figure (median reported)")->check(CLI::PositiveNumber);
+  app.add_option("--sample", sample,
+                 "above --full-max moments the direct sum is timed (and Barnes–Hut checked) "
+                 "on this many evenly spaced targets and extrapolated to all")->check(CLI::PositiveNumber);
+  app.add_option("--full-max", full_max, "largest size evaluated at every target by the direct sum");
+  app.add_option("--leaf", leaf, "Barnes–Hut leaf size")->check(CLI::PositiveNumber);
+  app.add_option("--group", group, "Barnes–Hut target group size")->check(CLI::PositiveNumber);
+  app.add_option("--order", order, "Barnes–Hut expansion order (1: quadrupole, 2: octupole)")
+      ->check(CLI::Range(1, 2));
+  std::string stat = "median", clock = "wall";
+  app.add_option("--clock", clock, "wall (default) or cpu: process CPU time, steadier on a "
+                 "busy machine but the sum over threads")->check(CLI::IsMember({"wall", "cpu"}));
+  app.add_option("--stat", stat, "median (default) or min over the repeats (min is steadier "
+                 "on a shared machine)")->check(CLI::IsMember({"median", "min"}));
+  app.add_flag("--portable", portable, "also time the portable (non-AVX-512) direct loop");
+  app.add_flag("--no-bh", no_bh, "direct sum only");
+  CLI11_PARSE(app, argc, argv);
+  g_use_min = stat == "min";
+  g_cpu_clock = clock == "cpu";
+
+  json out;
+  out["simd_kernel"] = mag::detail::simd_kernel_active();
+  out["repeat"] = repeat;
+  out["stat"] = stat;
+  out["clock"] = clock;
+  out["moments"] = moments;
+  out["results"] = json::array();
+  std::printf("# AVX-512 kernel: %s; %s of %d repeats; pairs/s = targets × sources / time\n",
+              mag::detail::simd_kernel_active() ? "yes" : "no", g_use_min ? "min" : "median", repeat);
+  for (const std::string& layout : layouts) {
+    if (layout != "pile" && layout != "cloud") {
+      std::fprintf(stderr, "unknown layout %s (pile, cloud)\n", layout.c_str());
+      return 2;
+    }
+    for (int n : sizes) {
+      const bool scene = moments == "scene";
+      const mag::MomentSet set = layout == "pile" ? pile(n, 7, scene) : cloud(n, 7, scene);
+      const bool sampled = n > full_max;
+      const std::vector<int> tgt = sample_targets(n, sampled ? sample : n);
+      const double frac = double(tgt.size()) / n;  // sampled share of the targets
+      mag::FieldOptions direct;
+      mag::FieldWorkspace ws;
+      // reference: the direct sum at the sampled targets
+      std::vector<Vec3> Href, H;
+      std::vector<Mat3> Jref, J;
+      mag::compute_fields_at(set, direct, tgt, &Href, &Jref, &ws);
+      for (int nt : threads) {
+        omp_set_num_threads(nt);
+        json rec;
+        rec["layout"] = layout;
+        rec["n"] = n;
+        rec["threads"] = nt;
+        rec["direct_sampled_targets"] = sampled ? static_cast<int>(tgt.size()) : 0;
+        auto time_direct = [&](bool jac) {
+          const double t = median_seconds(repeat, [&] {
+            if (sampled) mag::compute_fields_at(set, direct, tgt, &H, jac ? &J : nullptr, &ws);
+            else mag::compute_fields(set, direct, &H, jac ? &J : nullptr, &ws);
+          });
+          return t / frac;  // extrapolated to every target
+        };
+        const double pairs = double(n) * double(n);
+        const double td_h = time_direct(false), td_hj = time_direct(true);
+        rec["direct"] = {{"time_H_s", td_h}, {"time_HJ_s", td_hj},
+                         {"pairs_per_s_H", pairs / td_h}, {"pairs_per_s_HJ", pairs / td_hj}};
+        std::printf("%-5s n=%6d threads=%d direct%s: H %9.3f ms %.3g pairs/s | H+J %9.3f ms %.3g pairs/s\n",
+                    layout.c_str(), n, nt, sampled ? " (sampled, extrapolated)" : "",
+                    td_h * 1e3, pairs / td_h, td_hj * 1e3, pairs / td_hj);
+        if (portable) {
+          mag::detail::enable_simd_kernel(false);
+          const double tp_h = time_direct(false), tp_hj = time_direct(true);
+          mag::detail::enable_simd_kernel(true);
+          rec["portable"] = {{"time_H_s", tp_h}, {"time_HJ_s", tp_hj},
+                             {"pairs_per_s_H", pairs / tp_h}, {"pairs_per_s_HJ", pairs / tp_hj}};
+          std::printf("%-5s n=%6d threads=%d portable: H %9.3f ms %.3g pairs/s | H+J %9.3f ms %.3g pairs/s\n",
+                      layout.c_str(), n, nt, tp_h * 1e3, pairs / tp_h, tp_hj * 1e3, pairs / tp_hj);
+        }
+        rec["barnes_hut"] = json::array();
+        for (double theta : no_bh ? std::vector<double>{} : thetas) {
+          mag::FieldOptions bh;
+          bh.solver = mag::FieldSolver::BarnesHut;
+          bh.bh_theta = theta;
+          bh.bh_leaf_size = leaf;
+          bh.bh_group_size = group;
+          bh.bh_order = order;
+          const double tb_h = median_seconds(repeat, [&] { mag::compute_fields(set, bh, &H, nullptr, &ws); });
+          const Errors eh = errors(tgt, H, nullptr, Href, nullptr);
+          const double tb_hj = median_seconds(repeat, [&] { mag::compute_fields(set, bh, &H, &J, &ws); });
+          const Errors ej = errors(tgt, H, &J, Href, &Jref);
+          const mag::BarnesHutStats st = mag::barnes_hut_stats(ws);
+          rec["barnes_hut"].push_back({{"theta", theta}, {"leaf", leaf}, {"group", group}, {"order", order},
+                                       {"time_H_s", tb_h}, {"time_HJ_s", tb_hj},
+                                       {"speedup_H", td_h / tb_h}, {"speedup_HJ", td_hj / tb_hj},
+                                       {"eff_pairs_per_s_H", pairs / tb_h},
+                                       {"eff_pairs_per_s_HJ", pairs / tb_hj},
+                                       {"H_err_max", eh.h_max}, {"H_err_rms", eh.h_rms},
+                                       {"J_err_max", ej.j_max}, {"J_err_rms", ej.j_rms},
+                                       {"near_pairs_per_target", st.near_pairs_per_target},
+                                       {"far_cells_per_target", st.far_cells_per_target},
+                                       {"build_s", st.build_s}, {"lists_s", st.lists_s},
+                                       {"eval_s", st.eval_s}});
+          std::printf("%-5s n=%6d threads=%d BH θ=%.2f: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "
+                      "err max %.2e rms %.2e | H+J %8.3f ms (×%5.1f) J err max %.2e rms %.2e "
+                      "| near %.0f far %.0f per target | build %.2f lists %.2f eval %.2f ms\n",
+                      layout.c_str(), n, nt, theta, tb_h * 1e3, td_h / tb_h, pairs / tb_h, eh.h_max,
+                      eh.h_rms, tb_hj * 1e3, td_hj / tb_hj, ej.j_max, ej.j_rms,
+                      st.near_pairs_per_target, st.far_cells_per_target, st.build_s * 1e3,
+                      st.lists_s * 1e3, st.eval_s * 1e3);
+        }
+        std::fflush(stdout);
+        out["results"].push_back(rec);
+      }
+    }
+  }
+  if (!json_path.empty()) {
+    const std::filesystem::path p(json_path);
+    if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+    std::ofstream f(json_path);
+    if (!f) {
+      std::fprintf(stderr, "cannot write %s\n", json_path.c_str());
+      return 1;
+    }
+    f << out.dump(2) << "\n";
+    std::printf("# wrote %s\n", json_path.c_str());
+  }
+  return 0;
+}

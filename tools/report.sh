@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# tools/report.sh — rebuilds the experiment report from scratch into out/report/: the paper's
+# Table 1 and Figs. 8, 9, 10, the uniqueness figure (§6.3), speed against accuracy and
+# scaling, as CSV/JSON + PNG charts + index.md. About 10–25 minutes on 2 cores.
+#
+#   bash tools/report.sh            reduced Fig. 9 grid (11 × 101 cells × 64 directions)
+#   bash tools/report.sh --quick    shorter benchmark windows, no 10,000-ball scaling point
+# The full-resolution Fig. 9 is separate (hours):
+#   build/release/tools/experiments fig9 --dt-steps 51 --h-steps 1001 --dirs 10000 --shard i/n
+set -euo pipefail
+cd "$(dirname "$0")/.."
+quick=0
+for a in "$@"; do
+  case "$a" in
+    --quick) quick=1 ;;
+    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "report.sh: unknown option '$a' (try --help)" >&2; exit 2 ;;
+  esac
+done
+bash tools/setup.sh --no-demo
+out=out/report
+rm -rf "$out"
+mkdir -p "$out"
+bin=build/release/tools
+t0=$(date +%s)
+echo "== Fig. 8 and uniqueness";  $bin/experiments fig8 --out "$out" | tee "$out/fig8.txt"
+echo "== Fig. 9 (reduced grid)";  $bin/experiments fig9 --out "$out" --methods all | tee "$out/fig9.txt"
+echo "== Fig. 10";                $bin/experiments fig10 --out "$out" | tee "$out/fig10.txt"
+echo "== speed against accuracy"; $bin/experiments speed --out "$out" | tee "$out/speed.txt"
+if [ "$quick" -eq 1 ]; then
+  echo "== Table 1 and scaling (quick)"
+  $bin/bench --warmup 100 --steps 50 --scaling 250,1000,2500 --json "$out/bench.json" | tee "$out/bench.txt"
+else
+  echo "== Table 1 and scaling"
+  $bin/bench --json "$out/bench.json" | tee "$out/bench.txt"
+fi
+if [ -x $bin/bench_kernel ]; then
+  echo "== kernel throughput"
+  $bin/bench_kernel --json "$out/kernel.json" | tee "$out/kernel.txt"
+fi
+/usr/bin/python3 tools/charts.py "$out"
+/usr/bin/python3 tools/report_index.py "$out"
+echo "report: $out/index.md ($(( $(date +%s) - t0 )) s)"

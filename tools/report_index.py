@@ -1,0 +1,159 @@
+#!/usr/bin/python3
+"""tools/report_index.py — writes OUT_DIR/index.md: every chart of the report beside the
+paper's number and a sentence on where our result agrees or differs.
+
+    /usr/bin/python3 tools/report_index.py OUT_DIR"""
+import datetime
+import json
+import os
+import subprocess
+import sys
+
+
+def load(out, name):
+    p = os.path.join(out, name)
+    if not os.path.exists(p):
+        return None
+    with open(p) as f:
+        return json.load(f)
+
+
+def img(out, name, alt):
+    return f"![{alt}]({name})\n" if os.path.exists(os.path.join(out, name)) else f"*({name} not produced)*\n"
+
+
+def fmt(x, nd=3):
+    if x is None:
+        return "–"
+    if isinstance(x, (int,)) and not isinstance(x, bool):
+        return str(x)
+    return f"{x:.{nd}g}"
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__)
+        sys.exit(2)
+    out = sys.argv[1]
+    L = []
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                                text=True).stdout.strip()
+    except OSError:
+        commit = "?"
+    cpu = "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    L.append("# magsim experiment report\n")
+    L.append(f"Generated {datetime.datetime.now():%Y-%m-%d %H:%M} by `bash tools/report.sh`, "
+             f"commit {commit}, on {os.cpu_count()} cores ({cpu}). Paper: *Fast Stabilization "
+             "of Inducible Magnet Simulation* (`../shared/paper.md`). Timings are medians of "
+             "one run on a shared machine; ratios are measured within the same run.\n")
+
+    b = load(out, "bench.json")
+    L.append("## Table 1 — T_i, T_f, T_r\n")
+    if b:
+        L.append(f"Medians over {b['window_steps']} rigid steps (Δt_r = 1 ms) after "
+                 f"{b['warmup_steps']} warm-up steps. The paper reports ms *per frame* on a "
+                 "6-core i7-8700 with Bullet; we report ms per 1 ms rigid step on 2 cores.\n")
+        L.append("| scene | method | T_i | T_f | T_r | iterations/step | cap hit | paper T_i / T_f / T_r |")
+        L.append("|---|---|---|---|---|---|---|---|")
+        for r in b["runs"]:
+            t = r["timing_ms"]
+            p = r.get("paper_ms_per_frame")
+            ps = f"{p['T_i']} / {p['T_f']} / {p['T_r']}" if p else "–"
+            err = " (failed: " + r["error"] + ")" if "error" in r else ""
+            L.append(f"| {r['scene']} | {r['method']}{err} | {fmt(t['T_i']['median'])} | "
+                     f"{fmt(t['T_f']['median'])} | {fmt(t['T_r']['median'])} | "
+                     f"{fmt(r['iterations_median'])} | {100 * r['cap_hit_fraction']:.0f} % | {ps} |")
+        L.append("")
+        for s, v in b.get("ratios", {}).items():
+            paper = {"balls_up": 1.8 / 20, "alphabets": 1.3 / 3.3, "falling_magnet": 36 / 251,
+                     "sakura_tree": 61 / 778}.get(s)
+            L.append(f"- {s}: T_i ours / Kim 2018 = **{v['T_i_ours_over_kim']:.3f}** "
+                     f"(paper {paper:.3f})" if paper else f"- {s}: {v}")
+        L.append("")
+        L.append(img(out, "table1.png", "Table 1"))
+        if b.get("scaling"):
+            L.append("### Scaling (sakura_tree with N balls)\n")
+            L.append("| balls | method | total ms/step | T_i | T_f | T_r | iterations |")
+            L.append("|---|---|---|---|---|---|---|")
+            for r in b["scaling"]:
+                L.append(f"| {r['balls']} | {r['method']} | {fmt(r['total_ms'])} | {fmt(r['T_i'])} | "
+                         f"{fmt(r['T_f'])} | {fmt(r['T_r'])} | {fmt(r['iterations_median'])} |")
+            L.append("")
+            L.append(img(out, "scaling.png", "scaling"))
+    else:
+        L.append("*(bench.json not produced)*\n")
+
+    f8 = load(out, "fig8.json")
+    L.append("## Fig. 8 — e_M per iteration on crystal_balls\n")
+    L.append(img(out, "fig8.png", "Fig. 8"))
+    if f8:
+        L.append("Paper: Kim 2018 and damping-only LLG do not converge under the strong magnet "
+                 "and converge slowly under the weak one; ours converges fast under both.\n")
+        L.append("| magnet (max \\|H\\|/Ms) | method | iterations to e_M ≤ 1e-4 | to ≤ 1e-6 | e_M at the end |")
+        L.append("|---|---|---|---|---|")
+        for mg in ("weak", "strong"):
+            for m, r in f8[mg]["methods"].items():
+                L.append(f"| {mg} ({f8[mg]['max_H_over_Ms']:.2f}) | {m} | "
+                         f"{r['iterations_to_1e-4'] if r['iterations_to_1e-4'] > 0 else 'never'} | "
+                         f"{r['iterations_to_1e-6'] if r['iterations_to_1e-6'] > 0 else 'never'} | "
+                         f"{r['final_e_M']:.2e} |")
+        L.append("")
+        u = f8.get("uniqueness", {})
+        L.append("## §6.3 — uniqueness (weak magnet)\n")
+        for k in ("ours", "ours-realigned"):
+            if k in u:
+                L.append(f"- mean \\|M_K − M_O\\|/\\|M_K\\| ({k}) = **{100 * u[k]['mean']:.2f} %** "
+                         f"(max {100 * u[k]['max']:.2f} %); paper: 0.08 %.")
+        if "ground_truths" in u:
+            L.append(f"- The two curves' own ground truths (eq. 7 against eq. 10) differ by "
+                     f"{100 * u['ground_truths']['mean']:.2f} % on average: the gap is the "
+                     "curves' (tanh(x)/x < 1 where 3|H|/Ms is not small), not the dynamics'.")
+        L.append("")
+
+    f9 = load(out, "fig9.json")
+    L.append("## Fig. 9 — stability map\n")
+    L.append(img(out, "fig9.png", "Fig. 9"))
+    if f9:
+        g = f9["grid"]
+        L.append(f"Reduced grid: {g['dt_steps']} Δt values × {g['h_steps']} \\|H\\| values × "
+                 f"{g['directions']} directions (paper: 51 × 1001 × 10,000); converged when "
+                 f"e_M < {g['tol']}, cap 999. One moment, sub-magnetizations ±60° from a fixed "
+                 "axis (\\|M\\| = Ms/2), H = s·\\|M\\| in a random direction.\n")
+        L.append("| method | cells converging in every direction | mean iterations |")
+        L.append("|---|---|---|")
+        for m, r in f9.items():
+            if m == "grid":
+                continue
+            L.append(f"| {m} | {100 * r['converged_fraction']:.1f} % | {r['mean_iterations']:.1f} |")
+        L.append("\nPaper: ours superior to Kim 2018 and damping-only LLG over the whole map.\n")
+
+    f10 = load(out, "fig10.json")
+    L.append("## Fig. 10 — force near a uniformly magnetized sphere\n")
+    L.append(img(out, "fig10.png", "Fig. 10"))
+    if f10:
+        L.append(f"\\|F_ours\\| / \\|F_Kim\\| ranges **{f10['ratio_ours_over_kim_min']:.2f} … "
+                 f"{f10['ratio_ours_over_kim_max']:.2f}** over the cross-section. The paper "
+                 "says Kim 2018's forces are the stronger ones; with eq. 4 as printed the Zeeman "
+                 "force is 8× the classic one in the linear regime (the 2M term with ∂M/∂H = 3I) "
+                 "and tends to it at saturation, so this claim does not reproduce.\n")
+
+    L.append("## Speed against accuracy (beyond the paper)\n")
+    L.append(img(out, "speed_accuracy.png", "speed against accuracy"))
+    L.append(img(out, "dt_iterations.png", "dt against iterations"))
+    k = load(out, "kernel.json")
+    if k:
+        L.append("## Field kernel\n")
+        L.append("```\n" + json.dumps(k, indent=1)[:4000] + "\n```\n")
+    with open(os.path.join(out, "index.md"), "w") as f:
+        f.write("\n".join(L) + "\n")
+    print(f"report_index: wrote {os.path.join(out, 'index.md')}")
+
+
+if __name__ == "__main__":
+    main()
