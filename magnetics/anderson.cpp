@@ -195,7 +195,13 @@ RelaxStats relax_anderson(MomentSet* set, const DynamicsOptions& opt, MagWorkspa
     st.last_change = change;
     st.last_residual = f_max;
     if (on_iteration) on_iteration(it, *set);
-    if (change < opt.tol && f_max < opt.tol) {
+    // the dynamics' stopping rule (DynamicsOptions::criterion): the residual of the iterate
+    // the fields came from, or the change of this step — with the residual too, so that a
+    // stalled mixing cannot stop early
+    const double crit = opt.criterion == DynamicsOptions::Criterion::Residual
+                            ? f_max
+                            : std::max(change, f_max);
+    if (crit < opt.tol) {
       st.converged = true;
       break;
     }

@@ -17,8 +17,9 @@ namespace magsim::mag {
 /// (MomentSet::set_magnetization), so the dynamics can warm-start from the result.
 /// Safeguards: columns that make the least-squares problem ill-conditioned are dropped; when
 /// the residual grows by more than opt.anderson_restart_growth the history is cleared and β
-/// halved (down to 1/8) for the next steps. Stops when max_j |ΔM_j|/Ms_j < opt.tol (and
-/// the Picard residual at the evaluated iterate is below opt.tol too) or at opt.max_iter.
+/// halved (down to 1/8) for the next steps. Stops by the dynamics' rule (opt.criterion):
+/// Residual — max_j |M_j − f(H_j)|/Ms_j of the evaluated iterate < opt.tol; Change — the
+/// step's max_j |ΔM_j|/Ms_j < opt.tol, and that residual too — or at opt.max_iter.
 /// Fields of the last evaluated iterate are left in ws->H.
 RelaxStats relax_anderson(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
                           const std::function<void(int, const MomentSet&)>& on_iteration = {});

@@ -443,7 +443,7 @@ int main(int argc, char** argv) {
                "moments.csv"};
   Args a;
   app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
-  app.add_option("--method", a.method, "ours | ours-realigned | kim2018 | damping-llg | exact (default: the scene's)")
+  app.add_option("--method", a.method, "ours-realigned | ours | kim2018 | damping-llg | anderson | exact (default: the scene's, ours-realigned)")
       ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "exact"}));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(CLI::PositiveNumber);

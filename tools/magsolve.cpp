@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
   int max_iter = 999;
   app.add_option("case", path, "CASE.json: {\"external_field\": [Hx,Hy,Hz], \"moments\": [...]}")
       ->required();
-  app.add_option("--method", method_name, "ours|ours-realigned|kim2018|damping-llg|exact")
+  app.add_option("--method", method_name, "ours|ours-realigned|kim2018|damping-llg|exact|anderson")
       ->capture_default_str();
   app.add_option("--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6]")
       ->capture_default_str();
@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
   mag::DynamicsOptions opt;
   if (!mag::parse_method(method_name, &opt.method)) {
     std::fprintf(stderr, "magsolve: unknown method '%s' (ours, ours-realigned, kim2018, "
-                         "damping-llg, exact)\n", method_name.c_str());
+                         "damping-llg, exact, anderson)\n", method_name.c_str());
     return 2;
   }
   opt.dt = dt;
