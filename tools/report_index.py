@@ -73,8 +73,9 @@ def main():
         for s, v in b.get("ratios", {}).items():
             paper = {"balls_up": 1.8 / 20, "alphabets": 1.3 / 3.3, "falling_magnet": 36 / 251,
                      "sakura_tree": 61 / 778}.get(s)
-            L.append(f"- {s}: T_i ours / Kim 2018 = **{v['T_i_ours_over_kim']:.3f}** "
-                     f"(paper {paper:.3f})" if paper else f"- {s}: {v}")
+            parts = ", ".join(f"{k[4:-9]} **{x:.3f}**" for k, x in sorted(v.items()))
+            L.append(f"- {s}: T_i over Kim 2018's: {parts}" +
+                     (f" (paper, ours: {paper:.3f})" if paper else ""))
         L.append("")
         L.append(img(out, "table1.png", "Table 1"))
         if b.get("scaling"):
