@@ -32,17 +32,11 @@
 #include <cstdint>
 #include <limits>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define MAGSIM_AVX512_KERNEL 1
-#define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
-#endif
-
 namespace magsim::mag {
 
 namespace {
 
-constexpr double kInv4Pi = 1.0 / (4.0 * kPi);
+using detail::kInv4Pi;
 constexpr int kMortonBits = 21;  // per axis
 
 // index of the symmetric pair (c, e) in xx, yy, zz, xy, xz, yz order

@@ -17,17 +17,9 @@
 #include <limits>
 #include <sstream>
 
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define MAGSIM_AVX512_KERNEL 1
-#define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
-#endif
-
 namespace magsim::mag {
 
-namespace {
-constexpr double kInv4Pi = 1.0 / (4.0 * kPi);
-}
+using detail::kInv4Pi;
 
 // eq. 1: h = (1/4π)(3 r (r·m) − q m)/q^{5/2}, q = |r|² + ε²
 Vec3 dipole_field(const Vec3& r, const Vec3& m, double eps2) {

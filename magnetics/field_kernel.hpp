@@ -4,10 +4,22 @@
 // tests and benchmark).
 #pragma once
 
+#include "magnetics/types.hpp"
+
 #include <cstddef>
 #include <vector>
 
+// AVX-512 kernels are compiled per function (target attribute) and chosen at run time, so
+// the rest of the build stays at AVX2 (see CMakeLists.txt)
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define MAGSIM_AVX512_KERNEL 1
+#define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
+#endif
+
 namespace magsim::mag::detail {
+
+inline constexpr double kInv4Pi = 1.0 / (4.0 * kPi);  ///< 1/4π of eq. 1
 
 /// Sources are padded to a multiple of this with zero moments far away (they add exactly 0).
 inline constexpr std::size_t kSourcePad = 8;
