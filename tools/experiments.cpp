@@ -60,6 +60,17 @@ std::vector<mag::Method> parse_methods(const std::string& list) {
   return v;
 }
 
+/// Options that run exactly `iters` sweeps of method m (tol unreachable: the window is
+/// fixed, e_M is what the experiments record).
+mag::DynamicsOptions window(mag::Method m, int iters, double dt = 100e-9) {
+  mag::DynamicsOptions d;
+  d.method = m;
+  d.dt = dt;
+  d.max_iter = iters;
+  d.tol = 1e-300;
+  return d;
+}
+
 mag::MomentSet crystal(double strength) {
   magsim::scenes::SceneParams p;
   p.strength = strength;
@@ -104,10 +115,7 @@ int run_fig8(const Fig8Opts& o) {
     summary[label]["max_H_over_Ms"] = hmax;
     for (mag::Method m : parse_methods(o.methods)) {
       mag::MomentSet s = base;
-      mag::DynamicsOptions d;
-      d.method = m;
-      d.max_iter = o.iters;
-      d.tol = 1e-300;  // run the whole window; e_M is what is recorded
+      const mag::DynamicsOptions d = window(m, o.iters);
       mag::MagWorkspace ws;
       const auto& gt = mag::curve_of(m) == mag::Curve::Kim ? gt_kim.M : gt_tanh.M;
       int first4 = -1, first6 = -1;
@@ -336,10 +344,7 @@ int run_speed(const SpeedOpts& o) {
       std::vector<double> per_sweep;
       for (int r = 0; r < o.repeat; ++r) {
         mag::MomentSet s = base;
-        mag::DynamicsOptions d;
-        d.method = m;
-        d.max_iter = o.iters;
-        d.tol = 1e-300;
+        const mag::DynamicsOptions d = window(m, o.iters);
         mag::MagWorkspace ws;
         const auto t0 = Clock::now();
         mag::relax_magnetization(&s, d, &ws);
@@ -348,10 +353,7 @@ int run_speed(const SpeedOpts& o) {
       std::sort(per_sweep.begin(), per_sweep.end());
       const double sweep_ms = per_sweep[per_sweep.size() / 2];
       mag::MomentSet s = base;
-      mag::DynamicsOptions d;
-      d.method = m;
-      d.max_iter = o.iters;
-      d.tol = 1e-300;
+      const mag::DynamicsOptions d = window(m, o.iters);
       mag::MagWorkspace ws;
       mag::relax_magnetization(&s, d, &ws, [&](int k, const mag::MomentSet& cur) {
         csv << label << ',' << mag::method_name(m) << ',' << k << ',' << k * sweep_ms << ','
@@ -359,11 +361,7 @@ int run_speed(const SpeedOpts& o) {
       });
       for (double dt_ns : {30.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0}) {
         mag::MomentSet t = base;
-        mag::DynamicsOptions dd;
-        dd.method = m;
-        dd.dt = dt_ns * 1e-9;
-        dd.max_iter = o.iters;
-        dd.tol = 1e-300;
+        const mag::DynamicsOptions dd = window(m, o.iters, dt_ns * 1e-9);
         int first = -1;
         mag::relax_magnetization(&t, dd, &ws, [&](int k, const mag::MomentSet& cur) {
           if (first < 0 && mag::magnetization_error(cur, gt) <= 1e-4) first = k;
