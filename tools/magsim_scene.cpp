@@ -444,7 +444,7 @@ int main(int argc, char** argv) {
   Args a;
   app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
   app.add_option("--method", a.method, "ours-realigned | ours | kim2018 | damping-llg | anderson | exact (default: the scene's, ours-realigned)")
-      ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "exact"}));
+      ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "anderson", "exact"}));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(CLI::PositiveNumber);
   auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, 2000000000L));
