@@ -18,6 +18,8 @@
 //       "max_contacts": 4, "space": "hash" | "sap" | "simple", "auto_disable": false,
 //       "linear_damping": 0, "angular_damping": 0, "surface_layer": 0,
 //       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
+//       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]
+//       "bh_threshold": 2500,                   // auto: Barnes–Hut from this many moments
 //       "magnetics": {"dt": 1e-7, "beta": 5, "alpha": 0.2, "gamma_c_max": 1,
 //                     "adaptive_gamma_bound": true, "adaptive_gamma_cap": 2.5,
 //                     "tol": 1e-4, "max_iter": 100, "min_pair_angle": 1e-6,
@@ -340,7 +342,8 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
   r.keys(j, path, {"method", "dt", "gravity", "ground", "friction", "restitution", "erp", "cfm",
                    "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
-                   "threads", "reaction_symmetric_forces", "magnetics"});
+                   "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
+                   "magnetics"});
   opt(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   opt(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
@@ -363,6 +366,16 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
   opt(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
   opt(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = r.integer(v, p, 0, 1024); });
   opt(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
+  mag::FieldOptions& f = o->magnetics.field;
+  opt(j, "field_solver", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (!mag::parse_field_solver(s, &f.solver)) r.fail(p, "unknown field solver '" + s + "' (direct, barnes-hut, auto)");
+  });
+  opt(j, "bh_theta", path, [&](const json& v, const std::string& p) {
+    f.bh_theta = r.number(v, p);
+    if (!(f.bh_theta > 0 && f.bh_theta <= 1)) r.fail(p, "must be in (0, 1] (got " + Reader::fmt(f.bh_theta) + ")");
+  });
+  opt(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = r.integer(v, p, 0, 1000000000); });
   opt(j, "magnetics", path, [&](const json& v, const std::string& p) { read_magnetics(r, v, p, &o->magnetics); });
   o->magnetics.method = o->method;
 }

@@ -2,7 +2,9 @@
 // T_i, T_f, T_r per 1 ms rigid step over a window after a warm-up, the magnetization
 // iterations per step, and the ratio ours/Kim 2018 of T_i measured in the same run; plus the
 // scaling of the step with the number of balls (sakura_tree with N balls). Writes JSON.
-// Timings are figures to read, never pass/fail.
+// Timings are figures to read, never pass/fail. --field-solver / --bh-theta / --bh-threshold
+// set the dipole-field summation of every run; the scaling runs use --scaling-solver (default
+// auto: Barnes–Hut from --bh-threshold moments on), or --field-solver when only that is given.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
 
@@ -53,19 +55,38 @@ std::vector<std::string> split(const std::string& s) {
 
 struct Window {
   double T_i = 0, T_f = 0, T_r = 0, total = 0, iters = 0, cap_frac = 0;
+  int moments = 0;
+  std::string solver;  ///< the field solver used (Auto resolved for the scene's moment count)
   bool failed = false;
   std::string error;
 };
 
+// Field options from the command line; unset ones keep the scene's.
+struct FieldChoice {
+  bool has_solver = false, has_theta = false, has_threshold = false;
+  mag::FieldSolver solver = mag::FieldSolver::Direct;
+  double theta = 0.3;
+  int threshold = 2500;
+  void apply(mag::FieldOptions* f) const {
+    if (has_solver) f->solver = solver;
+    if (has_theta) f->bh_theta = theta;
+    if (has_threshold) f->auto_threshold = threshold;
+  }
+};
+
 Window measure(const std::string& scene, mag::Method method, int count, int warmup, int steps,
-               int threads) {
+               int threads, const FieldChoice& field) {
   magsim::scenes::SceneParams p;
   p.count = count;
   eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
   d.options.method = method;
   if (threads > 0) d.options.threads = threads;
+  field.apply(&d.options.magnetics.field);
   eng::Simulation sim(d);
   Window w;
+  w.moments = sim.model().nmoment;
+  w.solver = mag::field_solver_name(
+      mag::resolve_solver(sim.model().options.magnetics.field, static_cast<std::size_t>(w.moments)));
   std::vector<double> ti, tf, tr, tot, it;
   int caps = 0;
   try {
@@ -96,7 +117,8 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
 json window_json(const Window& w) {
   json j = {{"timing_ms", {{"T_i", {{"median", w.T_i}}}, {"T_f", {{"median", w.T_f}}},
                            {"T_r", {{"median", w.T_r}}}, {"total", {{"median", w.total}}}}},
-            {"iterations_median", w.iters}, {"cap_hit_fraction", w.cap_frac}};
+            {"iterations_median", w.iters}, {"cap_hit_fraction", w.cap_frac},
+            {"field_solver", w.solver}, {"moments", w.moments}};
   if (w.failed) j["error"] = w.error;
   return j;
 }
@@ -112,6 +134,9 @@ int main(int argc, char** argv) {
   std::string scaling = "250,500,1000,2500,5000,10000";
   std::string scaling_methods = "ours";
   int warmup = 200, steps = 100, threads = 0, scaling_steps = 30;
+  std::string field_solver = "direct", scaling_solver = "auto";
+  double bh_theta = mag::FieldOptions{}.bh_theta;
+  int bh_threshold = mag::FieldOptions{}.auto_threshold;
   app.add_option("--scenes", scenes, "comma list of registry scenes")->capture_default_str();
   app.add_option("--methods", methods, "comma list of methods")->capture_default_str();
   app.add_option("--warmup", warmup, "steps before the window")->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -120,8 +145,39 @@ int main(int argc, char** argv) {
   app.add_option("--scaling", scaling, "ball counts for sakura_tree scaling, or 'none'")->capture_default_str();
   app.add_option("--scaling-methods", scaling_methods, "methods for the scaling runs")->capture_default_str();
   app.add_option("--scaling-steps", scaling_steps, "window of each scaling run, after as many warm-up steps")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--field-solver", field_solver,
+                 "direct | barnes-hut | auto: dipole-field summation of every run (default: the scene's, direct)");
+  app.add_option("--bh-theta", bh_theta, "Barnes-Hut opening angle, in (0, 1]")->capture_default_str();
+  app.add_option("--bh-threshold", bh_threshold, "auto: moments from which Barnes-Hut is used")
+      ->check(CLI::Range(0, 1000000000))->capture_default_str();
+  app.add_option("--scaling-solver", scaling_solver,
+                 "field solver of the scaling runs (default auto, or --field-solver when only that is given)")
+      ->capture_default_str();
   app.add_option("--json", out, "where to write the JSON")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+
+  FieldChoice table_field, scaling_field;
+  if (!mag::parse_field_solver(field_solver, &table_field.solver)) {
+    std::fprintf(stderr, "bench: --field-solver: unknown solver '%s' (direct, barnes-hut, auto)\n", field_solver.c_str());
+    return 2;
+  }
+  table_field.has_solver = app.count("--field-solver") > 0;
+  if (!app.count("--scaling-solver") && app.count("--field-solver")) scaling_solver = field_solver;
+  if (!mag::parse_field_solver(scaling_solver, &scaling_field.solver)) {
+    std::fprintf(stderr, "bench: --scaling-solver: unknown solver '%s' (direct, barnes-hut, auto)\n", scaling_solver.c_str());
+    return 2;
+  }
+  scaling_field.has_solver = true;
+  if (!(bh_theta > 0 && bh_theta <= 1)) {
+    std::fprintf(stderr, "bench: --bh-theta: the Barnes-Hut opening angle must be in (0, 1], got %g\n", bh_theta);
+    return 2;
+  }
+  for (FieldChoice* f : {&table_field, &scaling_field}) {
+    f->has_theta = app.count("--bh-theta") > 0;
+    f->theta = bh_theta;
+    f->has_threshold = app.count("--bh-threshold") > 0;
+    f->threshold = bh_threshold;
+  }
 
   std::vector<std::pair<std::string, mag::Method>> ms;
   for (const std::string& m : split(methods)) {
@@ -144,13 +200,18 @@ int main(int argc, char** argv) {
   json doc;
   doc["warmup_steps"] = warmup;
   doc["window_steps"] = steps;
+  // requested for the Table 1 runs (each run records the one used)
+  doc["field_solver"] = app.count("--field-solver") ? field_solver : "scene default";
+  doc["scaling_solver"] = scaling_solver;
+  doc["bh_theta"] = bh_theta;
+  doc["bh_threshold"] = bh_threshold;
   doc["runs"] = json::array();
-  std::printf("%-15s %-15s %9s %9s %9s %9s %7s %6s   paper T_i/T_f/T_r (ms per frame)\n",
-              "scene", "method", "T_i", "T_f", "T_r", "total", "iters", "cap%");
+  std::printf("%-15s %-15s %9s %9s %9s %9s %7s %6s %-10s   paper T_i/T_f/T_r (ms per frame)\n",
+              "scene", "method", "T_i", "T_f", "T_r", "total", "iters", "cap%", "solver");
   for (const std::string& s : split(scenes)) {
     std::map<std::string, double> ti;  // method name → median T_i
     for (const auto& [name, m] : ms) {
-      const Window w = measure(s, m, 0, warmup, steps, threads);
+      const Window w = measure(s, m, 0, warmup, steps, threads, table_field);
       json r = window_json(w);
       r["scene"] = s;
       r["method"] = name;
@@ -160,8 +221,8 @@ int main(int argc, char** argv) {
         r["paper_ms_per_frame"] = {{"T_i", v[0]}, {"T_f", v[1]}, {"T_r", v[2]}};
       }
       doc["runs"].push_back(r);
-      std::printf("%-15s %-15s %9.3f %9.3f %9.3f %9.3f %7.1f %5.0f%%", s.c_str(), name.c_str(),
-                  w.T_i, w.T_f, w.T_r, w.total, w.iters, 100 * w.cap_frac);
+      std::printf("%-15s %-15s %9.3f %9.3f %9.3f %9.3f %7.1f %5.0f%% %-10s", s.c_str(), name.c_str(),
+                  w.T_i, w.T_f, w.T_r, w.total, w.iters, 100 * w.cap_frac, w.solver.c_str());
       if (r.contains("paper_ms_per_frame"))
         std::printf("   %g / %g / %g", r["paper_ms_per_frame"]["T_i"].get<double>(),
                     r["paper_ms_per_frame"]["T_f"].get<double>(),
@@ -189,12 +250,16 @@ int main(int argc, char** argv) {
       if (!mag::parse_method(m, &x)) continue;
       for (const std::string& n : split(scaling)) {
         const int N = std::stoi(n);
-        const Window w = measure("sakura_tree", x, N, scaling_steps, scaling_steps, threads);
-        doc["scaling"].push_back({{"balls", N}, {"method", m}, {"total_ms", w.total},
-                                  {"T_i", w.T_i}, {"T_f", w.T_f}, {"T_r", w.T_r},
-                                  {"iterations_median", w.iters}});
-        std::printf("scaling sakura_tree N=%-6d %-15s total %9.3f ms (T_i %.3f, T_f %.3f, T_r %.3f), %.0f iterations\n",
-                    N, m.c_str(), w.total, w.T_i, w.T_f, w.T_r, w.iters);
+        const Window w = measure("sakura_tree", x, N, scaling_steps, scaling_steps, threads, scaling_field);
+        json row = {{"balls", N}, {"method", m}, {"total_ms", w.total},
+                    {"T_i", w.T_i}, {"T_f", w.T_f}, {"T_r", w.T_r},
+                    {"iterations_median", w.iters}, {"moments", w.moments},
+                    {"solver", w.solver}, {"solver_requested", scaling_solver}};
+        if (w.failed) row["error"] = w.error;
+        doc["scaling"].push_back(row);
+        std::printf("scaling sakura_tree N=%-6d %-15s total %9.3f ms (T_i %.3f, T_f %.3f, T_r %.3f), %.0f iterations, %s%s%s\n",
+                    N, m.c_str(), w.total, w.T_i, w.T_f, w.T_r, w.iters, w.solver.c_str(),
+                    w.failed ? "  FAILED: " : "", w.failed ? w.error.c_str() : "");
         std::fflush(stdout);
       }
     }

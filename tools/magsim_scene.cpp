@@ -59,6 +59,9 @@ struct Args {
   double dt_m = 0.0;
   double tol = 0.0;
   int max_iter = 0;
+  std::string field_solver;
+  double bh_theta = 0.0;
+  int bh_threshold = 0;
   bool list = false;
 };
 
@@ -100,6 +103,19 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
   if (app.count("--tol")) s.options.magnetics.tol = a.tol;
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
+  mag::FieldOptions& f = s.options.magnetics.field;
+  if (app.count("--field-solver") && !mag::parse_field_solver(a.field_solver, &f.solver))
+    throw UsageError("--field-solver: unknown solver '" + a.field_solver + "' (direct, barnes-hut, auto)");
+  if (app.count("--bh-theta")) {
+    if (!(a.bh_theta > 0 && a.bh_theta <= 1)) {
+      char got[32];
+      std::snprintf(got, sizeof got, "%g", a.bh_theta);
+      throw UsageError(std::string("--bh-theta: the Barnes-Hut opening angle must be in (0, 1], got ") + got);
+    }
+    f.bh_theta = a.bh_theta;
+  }
+  if (app.count("--bh-threshold")) f.auto_threshold = a.bh_threshold;
+  if (const std::string e = mag::validate(f); !e.empty()) throw UsageError("field options: " + e);
   s.options.magnetics.method = s.options.method;
   return s;
 }
@@ -223,6 +239,10 @@ json options_json(const engine::Model& m) {
               {"min_pair_angle", d.min_pair_angle},
               {"theta_integrator", d.theta_integrator == mag::ThetaIntegrator::Exact ? "exact" : "euler"},
               {"softening", d.field.softening},
+              {"field_solver", mag::field_solver_name(d.field.solver)},
+              {"field_solver_used", mag::field_solver_name(mag::resolve_solver(d.field, static_cast<std::size_t>(m.nmoment)))},
+              {"bh_theta", d.field.bh_theta},
+              {"bh_threshold", d.field.auto_threshold},
               {"threads", o.threads},
               {"gravity", vec3(o.gravity)},
               {"ground", o.ground},
@@ -430,9 +450,13 @@ int run(const Args& a, const CLI::App& app) {
     std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
     return 1;
   }
-  std::fprintf(stderr, "%s %s: %ld steps, t = %.4f s, wall %.2f s, median T_i %.3f T_f %.3f T_r %.3f ms; %s\n",
+  const mag::FieldOptions& fo = model.options.magnetics.field;
+  std::fprintf(stderr,
+               "%s %s: %ld steps, t = %.4f s, wall %.2f s, median T_i %.3f T_f %.3f T_r %.3f step %.3f ms; "
+               "field solver %s (%s, %d moments); %s\n",
                scene.name.c_str(), method.c_str(), sim.steps(), sim.time(), wall, median(Ti), median(Tf),
-               median(Tr), path.c_str());
+               median(Tr), median(total), mag::field_solver_name(mag::resolve_solver(fo, static_cast<std::size_t>(model.nmoment))),
+               mag::field_solver_name(fo.solver), model.nmoment, path.c_str());
   return 0;
 }
 
@@ -464,6 +488,13 @@ int main(int argc, char** argv) {
   app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
   app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(CLI::PositiveNumber);
   app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(CLI::Range(1, 1000000000));
+  app.add_option("--field-solver", a.field_solver,
+                 "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
+                 "and the forces alike (default: the scene's, direct); auto = Barnes-Hut from "
+                 "--bh-threshold moments on");
+  app.add_option("--bh-theta", a.bh_theta, "Barnes-Hut opening angle, in (0, 1] (default 0.3)");
+  app.add_option("--bh-threshold", a.bh_threshold, "auto: moments from which Barnes-Hut is used (default 2500)")
+      ->check(CLI::Range(0, 1000000000));
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
 
   try {

@@ -127,3 +127,23 @@ TEST_CASE("scene_file: bad files fail with the file and the JSON path", "[scene_
     CHECK_THAT(e.what(), Contains("/nonexistent/scene.json: cannot open"));
   }
 }
+
+TEST_CASE("scene_file: the field solver options are read and checked", "[scene_file]") {
+  const engine::SceneDesc s = scenes::parse_scene_json(
+      R"({"options": {"field_solver": "auto", "bh_theta": 0.5, "bh_threshold": 1000}, "bodies": []})", "x.json");
+  const mag::FieldOptions& f = s.options.magnetics.field;
+  CHECK(f.solver == mag::FieldSolver::Auto);
+  CHECK(f.bh_theta == 0.5);
+  CHECK(f.auto_threshold == 1000);
+  CHECK(scenes::parse_scene_json(kGood, "x.json").options.magnetics.field.solver == mag::FieldSolver::Direct);
+  CHECK(scenes::parse_scene_json(R"({"options": {"field_solver": "barnes-hut"}, "bodies": []})", "x.json")
+            .options.magnetics.field.solver == mag::FieldSolver::BarnesHut);
+  CHECK_THAT(error_of(R"({"options": {"field_solver": "octree"}, "bodies": []})"),
+             Contains("scene.json: options.field_solver: unknown field solver 'octree'"));
+  CHECK_THAT(error_of(R"({"options": {"field_solver": 1}, "bodies": []})"),
+             Contains("options.field_solver: must be a string"));
+  CHECK_THAT(error_of(R"({"options": {"bh_theta": 0}, "bodies": []})"), Contains("options.bh_theta: must be in (0, 1]"));
+  CHECK_THAT(error_of(R"({"options": {"bh_theta": 1.5}, "bodies": []})"), Contains("options.bh_theta: must be in (0, 1]"));
+  CHECK_THAT(error_of(R"({"options": {"bh_threshold": -1}, "bodies": []})"), Contains("options.bh_threshold: must be in"));
+  CHECK_THAT(error_of(R"({"options": {"bh_threshold": 2.5}, "bodies": []})"), Contains("options.bh_threshold: must be an integer"));
+}
