@@ -119,25 +119,42 @@ def fig10(out):
     plt.close(fig)
 
 
+def em_time_curves(path):
+    """(magnet, method) -> ([wall ms], [e_M]) from a speed CSV (speed_accuracy.csv layout)."""
+    data = defaultdict(lambda: ([], []))
+    for r in rows(path):
+        k = (r["magnet"], r["method"])
+        data[k][0].append(float(r["wall_ms"]))
+        data[k][1].append(max(float(r["e_M"]), 1e-16))
+    return data
+
+
+def em_time_panel(ax, data, magnet, title):
+    """e_M against wall time, one line per method (Newton as points; '+bh' runs dashed)."""
+    for (mg, method), (x, y) in sorted(data.items()):
+        if mg != magnet:
+            continue
+        base = method.split("+")[0]
+        if method == "exact":
+            ax.loglog(x, y, "o-", label="Newton (exact)", color=COLORS["exact"])
+        elif "+bh" in method:
+            th = float(method.split("+bh")[1])
+            ax.loglog(x, y, "--", label=f"{base}, Barnes–Hut θ={th:g}", color=COLORS.get(base),
+                      alpha=0.35 + 0.65 * (1 - th))
+        else:
+            ax.loglog(x, y, "-", label=method, color=COLORS.get(method))
+    ax.set_title(title)
+    ax.set_xlabel("wall time (ms)")
+    ax.grid(True, which="both", alpha=0.3)
+
+
 def speed(out):
     p = have(out, "speed_accuracy.csv")
     if p:
-        data = defaultdict(lambda: ([], []))
-        for r in rows(p):
-            k = (r["magnet"], r["method"])
-            data[k][0].append(float(r["wall_ms"]))
-            data[k][1].append(max(float(r["e_M"]), 1e-16))
+        data = em_time_curves(p)
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
         for ax, magnet in zip(axes, ["weak", "strong"]):
-            for (mg, method), (x, y) in sorted(data.items()):
-                if mg != magnet:
-                    continue
-                style = "o-" if method == "exact" else "-"
-                ax.loglog(x, y, style, label=method if method != "exact" else "Newton (exact)",
-                          color=COLORS.get(method))
-            ax.set_title(f"speed against accuracy, crystal_balls {magnet}")
-            ax.set_xlabel("wall time (ms)")
-            ax.grid(True, which="both", alpha=0.3)
+            em_time_panel(ax, data, magnet, f"speed against accuracy, crystal_balls {magnet}")
         axes[0].set_ylabel("e_M")
         axes[1].legend()
         fig.tight_layout()
@@ -164,6 +181,112 @@ def speed(out):
         fig.tight_layout()
         fig.savefig(os.path.join(out, "dt_iterations.png"), dpi=110)
         plt.close(fig)
+
+
+def snapshot_speed(out):
+    """speed_sakura.png: e_M against wall time on the sakura_tree snapshot from M = 0 and from
+    the engine's warm start, and the Barnes–Hut field's error against its time."""
+    p = have(out, "speed_sakura.csv")
+    if not p:
+        return
+    data = em_time_curves(p)
+    info = {}
+    j = os.path.join(out, "snapshot_speed.json")
+    if os.path.exists(j):
+        with open(j) as f:
+            info = json.load(f).get("snapshot", {})
+    where = (f"sakura_tree, {info['balls']} balls, t = {info['seconds']:.2f} s"
+             if info else "sakura_tree snapshot")
+    fig, axes = plt.subplots(1, 3, figsize=(18, 5.2))
+    em_time_panel(axes[0], data, "cold", f"{where}: from M = 0")
+    em_time_panel(axes[1], data, "warm", f"{where}: from the engine's warm start")
+    lo = min(min(y) for y in (v[1] for v in data.values()))
+    for ax in axes[:2]:
+        ax.set_ylim(max(lo / 2, 1e-13), 2)
+        ax.set_ylabel("e_M against Newton (eq. 12)")
+    axes[0].legend(fontsize=7, loc="lower left")
+    ax = axes[2]
+    b = os.path.join(out, "sakura_bh.csv")
+    if os.path.exists(b):
+        rs = rows(b)
+        bh = [r for r in rs if r["solver"] == "barnes-hut"]
+        direct = [float(r["ms_per_eval"]) for r in rs if r["solver"] == "direct"]
+        t = [float(r["ms_per_eval"]) for r in bh]
+        ax.loglog(t, [max(float(r["rms_rel_err"]), 1e-16) for r in bh], "o-", color="tab:purple",
+                  label="RMS relative error")
+        ax.loglog(t, [max(float(r["max_rel_err"]), 1e-16) for r in bh], "s--", color="tab:purple",
+                  label="max relative error")
+        for r in bh:
+            ax.annotate(f"θ={float(r['theta']):g}", (float(r["ms_per_eval"]), float(r["max_rel_err"])),
+                        textcoords="offset points", xytext=(4, 4), fontsize=8)
+        if direct:
+            ax.axvline(direct[0], color="black", ls=":", label=f"direct sum ({direct[0]:.2f} ms, exact)")
+        ax.set_xlabel("ms per field evaluation (H at every moment)")
+        ax.set_ylabel("field error against the direct sum")
+        ax.set_title("Barnes–Hut field on the snapshot")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    else:
+        ax.set_visible(False)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "speed_sakura.png"), dpi=110)
+    plt.close(fig)
+
+
+def tolerance(out):
+    """tolerance.png: relative force error against the tolerance per method (warm start and
+    M = 0) and the time it took, with balls_up's T_i per step."""
+    p = have(out, "tolerance_snapshot.csv")
+    if not p:
+        return
+    data = defaultdict(list)
+    for r in rows(p):
+        data[(r["start"], r["method"])].append(r)
+    fig, axes = plt.subplots(1, 3, figsize=(18, 5.2))
+    for ax, start, title in ((axes[0], "warm", "from the engine's warm start"),
+                             (axes[1], "cold", "from M = 0")):
+        for (st, method), rs in sorted(data.items()):
+            if st != start:
+                continue
+            rs = sorted(rs, key=lambda r: float(r["tol"]))
+            tol = [float(r["tol"]) for r in rs]
+            c = COLORS.get(method)
+            ax.loglog(tol, [max(float(r["force_err_max"]), 1e-16) for r in rs], "o-", color=c,
+                      label=f"{method} max")
+            ax.loglog(tol, [max(float(r["force_err_rms"]), 1e-16) for r in rs], "--", color=c,
+                      label=f"{method} RMS")
+            capped = [(t, float(r["force_err_max"])) for t, r in zip(tol, rs) if r["converged"] != "1"]
+            if capped:
+                ax.loglog(*zip(*capped), "x", color="black", ms=9)
+        ax.set_title(f"sakura_tree snapshot, {title}")
+        ax.set_xlabel("tolerance (max_j |M_j − f(H_j)| / Ms)")
+        ax.set_ylabel("|F − F_gt| / max |F_gt|")
+        ax.invert_xaxis()
+        ax.grid(True, which="both", alpha=0.3)
+    if not any(st == "cold" for st, _ in data):
+        axes[1].set_visible(False)
+    axes[0].legend(fontsize=7, ncol=2, title="x: iteration cap hit", title_fontsize=7)
+    ax = axes[2]
+    for (st, method), rs in sorted(data.items()):
+        rs = sorted(rs, key=lambda r: float(r["tol"]))
+        ax.loglog([float(r["tol"]) for r in rs], [float(r["wall_ms"]) for r in rs],
+                  "o-" if st == "warm" else "o:", color=COLORS.get(method),
+                  label=f"{method} ({st})", ms=4)
+    o = os.path.join(out, "tolerance_outcome.csv")
+    if os.path.exists(o):
+        rs = sorted(rows(o), key=lambda r: float(r["tol"]))
+        if rs:
+            ax.loglog([float(r["tol"]) for r in rs], [float(r["T_i_median_ms"]) for r in rs], "s-",
+                      color="black", lw=2, label=f"{rs[0]['scene']} T_i per step, median")
+    ax.set_title("time to the tolerance")
+    ax.set_xlabel("tolerance")
+    ax.set_ylabel("ms (snapshot: one solve; balls_up: per 1 ms step)")
+    ax.invert_xaxis()
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "tolerance.png"), dpi=110)
+    plt.close(fig)
 
 
 def bench(out):
@@ -225,7 +348,7 @@ def main():
     if not os.path.isdir(out):
         print(f"charts: {out} is not a directory", file=sys.stderr)
         sys.exit(2)
-    for f in (fig8, fig9, fig10, speed, bench):
+    for f in (fig8, fig9, fig10, speed, snapshot_speed, tolerance, bench):
         f(out)
     print(f"charts: written to {out}")
 

@@ -7,6 +7,11 @@
 //   experiments fig10    force magnitude near a uniformly magnetized sphere (Fig. 10)
 //   experiments speed    e_M against wall time per method and for the Newton solver; Δt_m
 //                        against iterations
+//   experiments tolerance       convergence tolerance against force error on a sakura_tree
+//                               snapshot and against balls_up's outcome
+//   experiments snapshot-speed  e_M against wall time on a sakura_tree snapshot; Barnes–Hut
+//                               field error against time per evaluation
+#include "engine/simulation.hpp"
 #include "magnetics/curves.hpp"
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
@@ -15,6 +20,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -318,9 +324,111 @@ int run_fig10(const Fig10Opts& o) {
 }
 
 // ---------------------------------------------------------------------------------------
+// Speed against accuracy: e_M against cumulative wall time. Shared by `speed` (crystal_balls)
+// and `snapshot-speed` (a sakura_tree snapshot).
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// One dynamics run of a speed chart: its name in the CSV and its options.
+struct SpeedRun {
+  std::string name;
+  mag::DynamicsOptions opt;
+};
+
+/// A run per method: `iters` fixed sweeps with the field options `field`.
+std::vector<SpeedRun> method_runs(const std::vector<mag::Method>& methods, int iters,
+                                  const mag::FieldOptions& field = {}) {
+  std::vector<SpeedRun> v;
+  for (mag::Method m : methods) {
+    SpeedRun r{mag::method_name(m), window(m, iters)};
+    r.opt.field = field;
+    v.push_back(r);
+  }
+  return v;
+}
+
+/// For every run, rows "label,name,k,wall_ms,e_M" (k = 1 … opt.max_iter) from `start`;
+/// e_M against the ground truth of the run's curve. Wall time per sweep: median over
+/// `repeat` runs without the e_M bookkeeping. Returns name → ms per sweep.
+std::map<std::string, double> speed_curves(std::ostream& csv, const std::string& label,
+                                           const mag::MomentSet& start,
+                                           const std::vector<SpeedRun>& runs,
+                                           const std::vector<Vec3>& gt_tanh,
+                                           const std::vector<Vec3>& gt_kim, int repeat) {
+  std::map<std::string, double> out;
+  for (const SpeedRun& r : runs) {
+    const auto& gt = mag::curve_of(r.opt.method) == mag::Curve::Kim ? gt_kim : gt_tanh;
+    std::vector<double> per_sweep;
+    for (int k = 0; k < repeat; ++k) {
+      mag::MomentSet s = start;
+      mag::MagWorkspace ws;
+      const auto t0 = Clock::now();
+      const mag::RelaxStats st = mag::relax_magnetization(&s, r.opt, &ws);
+      per_sweep.push_back(ms_since(t0) / std::max(1, st.iterations));
+    }
+    const double sweep_ms = median(per_sweep);
+    mag::MomentSet s = start;
+    mag::MagWorkspace ws;
+    mag::relax_magnetization(&s, r.opt, &ws, [&](int k, const mag::MomentSet& cur) {
+      csv << label << ',' << r.name << ',' << k << ',' << k * sweep_ms << ','
+          << mag::magnetization_error(cur, gt) << '\n';
+    });
+    std::printf("speed %-11s %-22s %.4f ms per sweep\n", label.c_str(), r.name.c_str(), sweep_ms);
+    out[r.name] = sweep_ms;
+  }
+  return out;
+}
+
+/// The Newton ground-truth solver run one step at a time from `start`: the solution and,
+/// per Newton step, the cumulative wall time (median over `repeat`) and the iterate.
+struct NewtonTrace {
+  mag::MomentSet solution;
+  std::vector<double> ms;                ///< cumulative wall time after step k + 1
+  std::vector<std::vector<Vec3>> iterate;
+  bool converged = false;
+};
+
+NewtonTrace newton_trace(const mag::MomentSet& start, mag::Curve curve,
+                         const mag::FieldOptions& field, int repeat = 1, double tol = 1e-12) {
+  NewtonTrace tr;
+  std::vector<std::vector<double>> step_ms;
+  for (int r = 0; r < repeat; ++r) {
+    mag::MomentSet s = start;
+    for (int k = 0; k < 60; ++k) {
+      const auto t0 = Clock::now();
+      const mag::ExactStats st = mag::solve_exact(&s, curve, field, 0.0, 1);
+      if (static_cast<int>(step_ms.size()) <= k) step_ms.emplace_back();
+      step_ms[k].push_back(ms_since(t0));
+      if (r == 0) tr.iterate.push_back(s.M);
+      if (st.residual <= tol) {
+        tr.converged = true;
+        break;
+      }
+    }
+    if (r == 0) tr.solution = s;
+  }
+  double cum = 0;
+  for (std::size_t k = 0; k < tr.iterate.size(); ++k) tr.ms.push_back(cum += median(step_ms[k]));
+  return tr;
+}
+
+/// Rows "label,exact,-1,wall_ms,e_M" for every Newton step of `tr` against `gt`.
+void newton_rows(std::ostream& csv, const std::string& label, const NewtonTrace& tr,
+                 const std::vector<Vec3>& gt) {
+  mag::MomentSet s = tr.solution;
+  for (std::size_t k = 0; k < tr.iterate.size(); ++k) {
+    s.M = tr.iterate[k];
+    csv << label << ",exact," << -1 << ',' << tr.ms[k] << ',' << mag::magnetization_error(s, gt)
+        << '\n';
+  }
+}
+
 // Speed against accuracy on crystal_balls (weak and strong): e_M against cumulative wall time
-// for every dynamics, and the Newton solver at a ladder of tolerances; Δt_m against
-// iterations to e_M ≤ 1e-4.
+// for every dynamics and per Newton step (from M = 0); Δt_m against iterations to e_M ≤ 1e-4.
 struct SpeedOpts {
   std::string out = "out/report";
   int iters = 999;
@@ -335,30 +443,16 @@ int run_speed(const SpeedOpts& o) {
   dtcsv << "magnet,method,dt_ns,iterations_to_1e-4\n";
   for (const auto& [label, strength] : {std::pair<std::string, double>{"weak", 0.05}, {"strong", 1.0}}) {
     const mag::MomentSet base = crystal(strength);
-    mag::MomentSet gt_tanh = base, gt_kim = base;
-    mag::solve_exact(&gt_tanh, mag::Curve::Tanh, {});
+    const NewtonTrace newton = newton_trace(base, mag::Curve::Tanh, {}, o.repeat);
+    mag::MomentSet gt_kim = base;
     mag::solve_exact(&gt_kim, mag::Curve::Kim, {});
+    const std::vector<Vec3>& gt_tanh = newton.solution.M;
+    speed_curves(csv, label, base, method_runs(dynamics_methods(), o.iters), gt_tanh, gt_kim.M,
+                 o.repeat);
+    newton_rows(csv, label, newton, gt_tanh);
+    mag::MagWorkspace ws;
     for (mag::Method m : dynamics_methods()) {
-      const auto& gt = mag::curve_of(m) == mag::Curve::Kim ? gt_kim.M : gt_tanh.M;
-      // wall time per sweep: median over repeats of a run without the e_M bookkeeping
-      std::vector<double> per_sweep;
-      for (int r = 0; r < o.repeat; ++r) {
-        mag::MomentSet s = base;
-        const mag::DynamicsOptions d = window(m, o.iters);
-        mag::MagWorkspace ws;
-        const auto t0 = Clock::now();
-        mag::relax_magnetization(&s, d, &ws);
-        per_sweep.push_back(ms_since(t0) / o.iters);
-      }
-      std::sort(per_sweep.begin(), per_sweep.end());
-      const double sweep_ms = per_sweep[per_sweep.size() / 2];
-      mag::MomentSet s = base;
-      const mag::DynamicsOptions d = window(m, o.iters);
-      mag::MagWorkspace ws;
-      mag::relax_magnetization(&s, d, &ws, [&](int k, const mag::MomentSet& cur) {
-        csv << label << ',' << mag::method_name(m) << ',' << k << ',' << k * sweep_ms << ','
-            << mag::magnetization_error(cur, gt) << '\n';
-      });
+      const auto& gt = mag::curve_of(m) == mag::Curve::Kim ? gt_kim.M : gt_tanh;
       for (double dt_ns : {30.0, 50.0, 75.0, 100.0, 125.0, 150.0, 175.0, 200.0}) {
         mag::MomentSet t = base;
         const mag::DynamicsOptions dd = window(m, o.iters, dt_ns * 1e-9);
@@ -368,24 +462,456 @@ int run_speed(const SpeedOpts& o) {
         });
         dtcsv << label << ',' << mag::method_name(m) << ',' << dt_ns << ',' << first << '\n';
       }
-      std::printf("speed %-6s %-15s %.4f ms per sweep\n", label.c_str(), mag::method_name(m), sweep_ms);
-    }
-    // the Newton ground-truth solver: time and e_M for a ladder of tolerances
-    for (double tol : {1e-1, 1e-2, 1e-4, 1e-6, 1e-9, 1e-12}) {
-      std::vector<double> times;
-      mag::MomentSet s = base;
-      for (int r = 0; r < o.repeat; ++r) {
-        s = base;
-        const auto t0 = Clock::now();
-        mag::solve_exact(&s, mag::Curve::Tanh, {}, tol);
-        times.push_back(ms_since(t0));
-      }
-      std::sort(times.begin(), times.end());
-      csv << label << ",exact," << -1 << ',' << times[times.size() / 2] << ','
-          << mag::magnetization_error(s, gt_tanh.M) << '\n';
     }
   }
   std::printf("speed: wrote %s/speed_accuracy.csv and dt_iterations.csv\n", o.out.c_str());
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// A sakura_tree snapshot: the scene stepped with ours-realigned until balls have landed on the
+// tree's magnets and are strongly magnetized (shared by `tolerance` and `snapshot-speed`).
+// At the scene's 1 ms rigid step the first balls to reach a branch-end magnet (t ≈ 0.12 s)
+// are flung off at 10²–10⁴ m/s and the tree is bare by 0.5 s; at 0.2 ms a few hundred balls
+// stay on it. The snapshot is cached in the output directory (both subcommands use it).
+struct SnapshotOpts {
+  int count = 1000;       // balls (the paper's scene: 2500; Newton is dense, O(count³))
+  double seconds = 0.15;  // simulated time before the snapshot (s)
+  double dt = 2e-4;       // rigid step while stepping to it (s)
+  bool reuse = true;      // load <out>/sakura_snapshot.json when it was made with these options
+  int threads = 1;        // OpenMP threads of the magnetics (0 = all)
+};
+
+/// OpenMP threads from here on (0 = all: the count before anything changed it). A Simulation
+/// sets its own count on every step, so call this again after stepping one.
+void use_threads(int n) {
+  static const int all = omp_get_max_threads();
+  omp_set_num_threads(n > 0 ? n : all);
+}
+
+struct Snapshot {
+  /// Moment positions of rigid step k + 1 with the magnetization (and sub-pairs) of step k:
+  /// the warm start the engine relaxes from in step k + 1.
+  mag::MomentSet warm;
+  mag::DynamicsOptions dyn;  ///< the scene's magnetization options (method ours-realigned)
+  bool reaction_symmetric = false;
+  json info;
+};
+
+void add_option(CLI::App* c, SnapshotOpts* s) {
+  c->add_option("--count", s->count, "balls in the sakura_tree scene (paper: 2500; Newton cost grows as count³)")
+      ->check(CLI::Range(10, 2500))->capture_default_str();
+  c->add_option("--seconds", s->seconds, "simulated time (s) of the snapshot, stepped with ours-realigned")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  c->add_option("--dt", s->dt, "rigid step (s) while stepping to the snapshot (the scene's: 1e-3)")
+      ->check(CLI::Range(1e-5, 1e-2))->capture_default_str();
+  c->add_flag("--reuse,!--no-reuse", s->reuse,
+              "reuse OUT/sakura_snapshot.json when made with the same --count/--seconds/--dt/"
+              "--threads (default: reuse)");
+  c->add_option("--threads", s->threads, "OpenMP threads for the magnetics and the stepping (0 = all); 1 times "
+                "steadily on a shared 2-core machine, where a descheduled thread stalls each parallel region")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+}
+
+json vecs_json(const std::vector<Vec3>& v) {
+  json a = json::array();
+  for (const Vec3& x : v) a.push_back({x.x(), x.y(), x.z()});
+  return a;
+}
+std::vector<Vec3> vecs_from(const json& a) {
+  std::vector<Vec3> v;
+  for (const json& x : a) v.emplace_back(x[0].get<double>(), x[1].get<double>(), x[2].get<double>());
+  return v;
+}
+
+/// The state of a moment set: positions, permanent moments and magnetizations.
+json state_json(const mag::MomentSet& s) {
+  return {{"position", vecs_json(s.position)}, {"M", vecs_json(s.M)}, {"M1", vecs_json(s.M1)},
+          {"M2", vecs_json(s.M2)}, {"m_perm", vecs_json(s.m_perm)}, {"seeded", s.seeded}};
+}
+bool load_state(const json& j, mag::MomentSet* s) {
+  const std::size_t n = s->size();
+  if (j["position"].size() != n || j["M"].size() != n) return false;
+  s->position = vecs_from(j["position"]);
+  s->M = vecs_from(j["M"]);
+  s->M1 = vecs_from(j["M1"]);
+  s->M2 = vecs_from(j["M2"]);
+  s->m_perm = vecs_from(j["m_perm"]);
+  s->seeded = j["seeded"].get<std::vector<std::uint8_t>>();
+  return true;
+}
+
+Snapshot sakura_snapshot(const SnapshotOpts& o, const std::string& out) {
+  magsim::scenes::SceneParams p;
+  p.count = o.count;
+  magsim::engine::SceneDesc d = magsim::scenes::find_scene("sakura_tree")->build(p);
+  d.options.method = mag::Method::OursRealigned;
+  d.options.dt = o.dt;
+  d.options.threads = o.threads;
+  use_threads(o.threads);
+  Snapshot sn;
+  sn.dyn = d.options.magnetics;
+  sn.dyn.method = mag::Method::OursRealigned;
+  sn.reaction_symmetric = d.options.reaction_symmetric_forces;
+  sn.warm = magsim::scenes::moment_set_at_rest(d);  // the structure; the state comes next
+  const json key = {{"count", o.count}, {"seconds", o.seconds}, {"dt", o.dt}, {"threads", o.threads}};
+  const std::string cache = out + "/sakura_snapshot.json";
+  if (o.reuse && std::filesystem::exists(cache)) {
+    json j;
+    std::ifstream(cache) >> j;
+    if (j.value("key", json()) == key && load_state(j["state"], &sn.warm)) {
+      sn.info = j["info"];
+      std::printf("snapshot: %s (t = %.3f s, %d balls on the tree)\n", cache.c_str(),
+                  sn.info["seconds"].get<double>(), sn.info["attached"].get<int>());
+      return sn;
+    }
+  }
+  const auto t0 = Clock::now();
+  magsim::engine::Simulation sim(d);
+  double max_speed = 0;
+  for (long k = 0, n = std::lround(o.seconds / d.options.dt); k < n; ++k) {
+    sim.step();
+    max_speed = std::max(max_speed, sim.metrics().max_speed);
+  }
+  const mag::MomentSet prev = sim.moments();
+  sim.step();
+  use_threads(o.threads);
+  const mag::MomentSet& now = sim.moments();
+  if (now.size() != sn.warm.size()) throw std::runtime_error("snapshot: moment count differs");
+  sn.warm.position = now.position;
+  sn.warm.m_perm = now.m_perm;
+  sn.warm.M = prev.M;
+  sn.warm.M1 = prev.M1;
+  sn.warm.M2 = prev.M2;
+  sn.warm.seeded = prev.seeded;
+  const magsim::engine::Metrics m = sim.metrics();
+  sn.info = {{"scene", "sakura_tree"}, {"balls", o.count}, {"seconds", sim.time()},
+             {"rigid_dt", o.dt}, {"method", "ours-realigned"}, {"attached", m.attached},
+             {"max_speed_so_far", std::max(max_speed, m.max_speed)},
+             {"moments", sn.warm.size()}, {"induced", sn.warm.induced_count()},
+             {"threads", o.threads},
+             {"stepping_s", ms_since(t0) / 1000}};
+  std::ofstream(cache) << json{{"key", key}, {"info", sn.info}, {"state", state_json(sn.warm)}}.dump() << "\n";
+  std::printf("snapshot: sakura_tree, %d balls, t = %.3f s at Δt_r = %g s: %d on the tree, max "
+              "speed so far %.0f m/s (%.1f s)\n", o.count, sim.time(), o.dt, m.attached,
+              sn.info["max_speed_so_far"].get<double>(), ms_since(t0) / 1000);
+  return sn;
+}
+
+/// Ground truths of the snapshot (Newton from the warm start, to 1e-12): eq. 10 (with its
+/// per-step trace) and eq. 7; the magnetization level goes into sn->info.
+struct GroundTruth {
+  NewtonTrace tanh;
+  mag::MomentSet kim;
+};
+
+GroundTruth snapshot_ground_truth(Snapshot* sn) {
+  GroundTruth g;
+  g.tanh = newton_trace(sn->warm, mag::Curve::Tanh, sn->dyn.field);
+  g.kim = sn->warm;
+  const auto t0 = Clock::now();
+  mag::solve_exact(&g.kim, mag::Curve::Kim, sn->dyn.field);
+  const double kim_ms = ms_since(t0);
+  const mag::MomentSet& s = g.tanh.solution;
+  double sum = 0;
+  int strong = 0, n = 0;
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    if (s.kind[j] != mag::MomentKind::Induced) continue;
+    const double r = s.M[j].norm() / s.Ms[j];
+    sum += r;
+    strong += r > 0.5;
+    ++n;
+  }
+  sn->info["mean_M_over_Ms"] = sum / n;
+  sn->info["balls_M_over_half_Ms"] = strong;
+  sn->info["newton_steps_from_warm"] = g.tanh.iterate.size();
+  sn->info["newton_ms_from_warm"] = g.tanh.ms.empty() ? 0.0 : g.tanh.ms.back();
+  sn->info["newton_kim_ms_from_warm"] = kim_ms;
+  sn->info["warm_start_e_M"] = mag::magnetization_error(sn->warm, s.M);
+  std::printf("ground truth: Newton %zu steps from the warm start, %.0f ms; mean |M|/Ms %.3f, "
+              "%d balls above Ms/2; warm start e_M %.2e\n",
+              g.tanh.iterate.size(), g.tanh.ms.empty() ? 0.0 : g.tanh.ms.back(), sum / n, strong,
+              sn->info["warm_start_e_M"].get<double>());
+  return g;
+}
+
+/// Forces of the method's force model and curve on every moment of s.
+std::vector<Vec3> forces_of(const mag::MomentSet& s, mag::Method m, const Snapshot& sn) {
+  mag::MagWorkspace ws;
+  std::vector<Vec3> F, tau;
+  mag::compute_forces(s, mag::force_model_of(m), mag::curve_of(m), sn.dyn.field, &ws, &F, &tau,
+                      nullptr, sn.reaction_symmetric);
+  return F;
+}
+
+/// max_j and RMS_j of |F_j − F_gt,j| / max_j |F_gt,j| over induced moments.
+std::pair<double, double> force_error(const mag::MomentSet& s, const std::vector<Vec3>& F,
+                                      const std::vector<Vec3>& F_gt) {
+  double fmax = 0, dmax = 0, d2 = 0;
+  int n = 0;
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    if (s.kind[j] != mag::MomentKind::Induced) continue;
+    fmax = std::max(fmax, F_gt[j].norm());
+    const double d = (F[j] - F_gt[j]).norm();
+    dmax = std::max(dmax, d);
+    d2 += d * d;
+    ++n;
+  }
+  if (fmax == 0 || n == 0) return {0.0, 0.0};
+  return {dmax / fmax, std::sqrt(d2 / n) / fmax};
+}
+
+std::vector<double> parse_doubles(const std::string& list, const std::string& flag) {
+  std::vector<double> v;
+  std::stringstream ss(list);
+  std::string x;
+  while (std::getline(ss, x, ',')) {
+    try {
+      v.push_back(std::stod(x));
+    } catch (const std::exception&) {
+      throw CLI::ValidationError(flag, "not a number: " + x);
+    }
+  }
+  return v;
+}
+
+// ---------------------------------------------------------------------------------------
+// Convergence tolerance against force error (on the sakura_tree snapshot) and against a
+// scene's outcome (balls_up run with ours-realigned at each tolerance).
+struct ToleranceOpts {
+  std::string out = "out/report";
+  SnapshotOpts snap;
+  std::string methods = "ours,ours-realigned,kim2018,anderson";
+  std::string tols = "1e-2,3e-3,1e-3,3e-4,1e-4,1e-5,1e-6";
+  int max_iter = 999;
+  int repeat = 3;
+  bool cold = true;
+  std::string outcome_scene = "balls_up";
+  double outcome_seconds = 1.0;
+  std::string outcome_tols = "1e-2,1e-3,1e-4,1e-5";
+};
+
+struct Outcome {
+  magsim::engine::Metrics last;
+  double max_speed_run = 0, ti_median = 0, iters_median = 0, iters_mean = 0, cap_fraction = 0;
+  double wall_s = 0;
+  bool failed = false;
+};
+
+/// Runs a registry scene for `seconds` with the method at tolerance tol (the scene's cap).
+Outcome run_outcome(const std::string& scene, mag::Method method, double tol, double seconds) {
+  const auto* e = magsim::scenes::find_scene(scene);
+  if (!e) throw CLI::ValidationError("--outcome-scene", "unknown scene " + scene);
+  magsim::engine::SceneDesc d = e->build({});
+  d.options.method = method;
+  d.options.magnetics.tol = tol;
+  magsim::engine::Simulation sim(d);
+  Outcome o;
+  std::vector<double> ti, it;
+  long caps = 0;
+  const auto t0 = Clock::now();
+  try {
+    for (long k = 0, n = std::lround(seconds / d.options.dt); k < n; ++k) {
+      sim.step();
+      const magsim::engine::StepProfile& pr = sim.last_profile();
+      ti.push_back(pr.T_i);
+      it.push_back(pr.iterations);
+      caps += pr.cap_hit;
+      o.max_speed_run = std::max(o.max_speed_run, sim.metrics().max_speed);
+    }
+  } catch (const magsim::engine::SimulationError& err) {
+    o.failed = true;
+    std::fprintf(stderr, "tolerance: %s at tol %g: %s\n", scene.c_str(), tol, err.what());
+  }
+  o.wall_s = ms_since(t0) / 1000;
+  o.last = sim.metrics();
+  o.ti_median = median(ti);
+  o.iters_median = median(it);
+  for (double x : it) o.iters_mean += x / std::max<std::size_t>(1, it.size());
+  o.cap_fraction = static_cast<double>(caps) / std::max<std::size_t>(1, it.size());
+  return o;
+}
+
+int run_tolerance(const ToleranceOpts& o) {
+  ensure_dir(o.out);
+  const auto t_all = Clock::now();
+  Snapshot sn = sakura_snapshot(o.snap, o.out);
+  const GroundTruth gt = snapshot_ground_truth(&sn);
+  json summary = {{"snapshot", sn.info}, {"max_iter", o.max_iter}};
+  std::ofstream csv(o.out + "/tolerance_snapshot.csv");
+  csv << "start,method,tol,iterations,converged,wall_ms,e_M,e_M_max_moment,force_err_max,force_err_rms\n";
+  std::map<mag::Curve, std::vector<Vec3>> F_gt;
+  F_gt[mag::Curve::Tanh] = forces_of(gt.tanh.solution, mag::Method::OursRealigned, sn);
+  F_gt[mag::Curve::Kim] = forces_of(gt.kim, mag::Method::Kim2018, sn);
+  const std::vector<double> tols = parse_doubles(o.tols, "--tols");
+  std::vector<std::string> starts = {"warm"};
+  if (o.cold) starts.push_back("cold");
+  for (const std::string& start : starts) {
+    mag::MomentSet base = sn.warm;
+    if (start == "cold") base.reset_magnetization();
+    for (mag::Method m : parse_methods(o.methods)) {
+      const mag::MomentSet& gs = mag::curve_of(m) == mag::Curve::Kim ? gt.kim : gt.tanh.solution;
+      json capped;  // a run that hit the cap: every smaller tolerance repeats it exactly
+      for (double tol : tols) {
+        json row;
+        if (!capped.is_null() && tol < capped["tol"].get<double>()) {
+          row = capped;
+        } else {
+          mag::DynamicsOptions d = sn.dyn;
+          d.method = m;
+          d.tol = tol;
+          d.max_iter = o.max_iter;
+          std::vector<double> ms;
+          mag::MomentSet s;
+          mag::RelaxStats st;
+          for (int r = 0; r < o.repeat && (r == 0 || ms[0] < 100); ++r) {  // long runs: once
+            s = base;
+            mag::MagWorkspace ws;
+            const auto t0 = Clock::now();
+            st = mag::relax_magnetization(&s, d, &ws);
+            ms.push_back(ms_since(t0));
+          }
+          const auto [fmax, frms] = force_error(s, forces_of(s, m, sn), F_gt[mag::curve_of(m)]);
+          row = {{"iterations", st.iterations}, {"converged", st.converged},
+                 {"wall_ms", median(ms)}, {"e_M", mag::magnetization_error(s, gs.M)},
+                 {"e_M_max_moment", mag::max_moment_error(s, gs.M)}, {"force_err_max", fmax},
+                 {"force_err_rms", frms}};
+          if (!st.converged) capped = row;
+          if (!st.converged) capped["tol"] = tol;
+        }
+        row["tol"] = tol;
+        csv << start << ',' << mag::method_name(m) << ',' << tol << ',' << row["iterations"] << ','
+            << row["converged"].get<bool>() << ',' << row["wall_ms"] << ',' << row["e_M"] << ','
+            << row["e_M_max_moment"] << ',' << row["force_err_max"] << ','
+            << row["force_err_rms"] << '\n';
+        summary["snapshot_runs"][start][mag::method_name(m)].push_back(row);
+        std::printf("tolerance %-4s %-15s tol %-6g %4d it%s %8.2f ms  e_M %.2e  |ΔF|/max|F| max %.2e rms %.2e\n",
+                    start.c_str(), mag::method_name(m), tol, row["iterations"].get<int>(),
+                    row["converged"].get<bool>() ? "" : " (cap)", row["wall_ms"].get<double>(),
+                    row["e_M"].get<double>(), row["force_err_max"].get<double>(),
+                    row["force_err_rms"].get<double>());
+      }
+    }
+  }
+  // the scene outcome: last, since a Simulation of few moments sets OpenMP to one thread
+  std::ofstream oc(o.out + "/tolerance_outcome.csv");
+  oc << "scene,method,tol,seconds,kinetic_energy,attached,max_speed_final,max_speed_run,"
+        "T_i_median_ms,iterations_median,iterations_mean,cap_fraction,failed\n";
+  for (double tol : parse_doubles(o.outcome_tols, "--outcome-tols")) {
+    const Outcome r = run_outcome(o.outcome_scene, mag::Method::OursRealigned, tol, o.outcome_seconds);
+    oc << o.outcome_scene << ",ours-realigned," << tol << ',' << r.last.time << ','
+       << r.last.kinetic_energy << ',' << r.last.attached << ',' << r.last.max_speed << ','
+       << r.max_speed_run << ',' << r.ti_median << ',' << r.iters_median << ','
+       << r.iters_mean << ',' << r.cap_fraction << ',' << r.failed << '\n';
+    summary["outcome"].push_back(
+        {{"scene", o.outcome_scene}, {"method", "ours-realigned"}, {"tol", tol},
+         {"seconds", r.last.time}, {"kinetic_energy", r.last.kinetic_energy},
+         {"attached", r.last.attached}, {"balls", r.last.dynamic_bodies},
+         {"max_speed_final", r.last.max_speed}, {"max_speed_run", r.max_speed_run},
+         {"T_i_median_ms", r.ti_median}, {"iterations_median", r.iters_median},
+         {"iterations_mean", r.iters_mean}, {"cap_fraction", r.cap_fraction},
+         {"failed", r.failed}});
+    std::printf("outcome %s tol %-6g t %.2f s: KE %.3e J, %d/%d attached, max speed %.3f m/s "
+                "(run %.3f), T_i median %.3f ms, %g iterations median, cap %.0f %% (%.1f s)\n",
+                o.outcome_scene.c_str(), tol, r.last.time, r.last.kinetic_energy, r.last.attached,
+                r.last.dynamic_bodies, r.last.max_speed, r.max_speed_run, r.ti_median,
+                r.iters_median, 100 * r.cap_fraction, r.wall_s);
+  }
+  summary["seconds"] = ms_since(t_all) / 1000;
+  std::ofstream(o.out + "/tolerance.json") << summary.dump(2) << "\n";
+  std::printf("tolerance: wrote %s/tolerance_snapshot.csv, tolerance_outcome.csv, tolerance.json "
+              "(%.1f s)\n", o.out.c_str(), ms_since(t_all) / 1000);
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Speed against accuracy on the sakura_tree snapshot: e_M against cumulative wall time per
+// method (from the warm start and from M = 0) and per Newton step; ours-realigned with the
+// Barnes–Hut field; and the Barnes–Hut field's error against its time per evaluation.
+struct SnapshotSpeedOpts {
+  std::string out = "out/report";
+  SnapshotOpts snap;
+  int iters = 200;
+  int repeat = 1;
+  std::string thetas = "0.2,0.3,0.5,0.7";
+  int field_repeat = 7;
+};
+
+int run_snapshot_speed(const SnapshotSpeedOpts& o) {
+  ensure_dir(o.out);
+  const auto t_all = Clock::now();
+  Snapshot sn = sakura_snapshot(o.snap, o.out);
+  const GroundTruth gt = snapshot_ground_truth(&sn);
+  const std::vector<Vec3>& gt_tanh = gt.tanh.solution.M;
+  json summary = {{"snapshot", sn.info}, {"iters", o.iters}};
+  std::ofstream csv(o.out + "/speed_sakura.csv");
+  csv << "magnet,method,iteration,wall_ms,e_M\n";
+  const std::vector<double> thetas = parse_doubles(o.thetas, "--thetas");
+  std::vector<SpeedRun> runs = method_runs(dynamics_methods(), o.iters, sn.dyn.field);
+  for (double th : thetas) {
+    SpeedRun r{"ours-realigned+bh" + json(th).dump(), window(mag::Method::OursRealigned, o.iters)};
+    r.opt.field = sn.dyn.field;
+    r.opt.field.solver = mag::FieldSolver::BarnesHut;
+    r.opt.field.bh_theta = th;
+    runs.push_back(r);
+  }
+  mag::MomentSet cold = sn.warm;
+  cold.reset_magnetization();
+  summary["ms_per_sweep"]["warm"] = speed_curves(csv, "warm", sn.warm, runs, gt_tanh, gt.kim.M, o.repeat);
+  newton_rows(csv, "warm", gt.tanh, gt_tanh);
+  summary["ms_per_sweep"]["cold"] = speed_curves(csv, "cold", cold, runs, gt_tanh, gt.kim.M, o.repeat);
+  const NewtonTrace newton_cold = newton_trace(cold, mag::Curve::Tanh, sn.dyn.field);
+  newton_rows(csv, "cold", newton_cold, gt_tanh);
+  summary["newton"] = {{"warm", {{"steps", gt.tanh.ms.size()}, {"ms", gt.tanh.ms.back()}}},
+                       {"cold", {{"steps", newton_cold.ms.size()}, {"ms", newton_cold.ms.back()}}}};
+  std::printf("newton: %zu steps, %.0f ms from the warm start; %zu steps, %.0f ms from M = 0\n",
+              gt.tanh.ms.size(), gt.tanh.ms.back(), newton_cold.ms.size(), newton_cold.ms.back());
+
+  // the Barnes–Hut field at the ground-truth magnetization against the direct sum
+  std::ofstream bh(o.out + "/sakura_bh.csv");
+  bh << "solver,theta,ms_per_eval,rms_rel_err,max_rel_err\n";
+  const mag::MomentSet& s = gt.tanh.solution;
+  std::vector<Vec3> H_ref;
+  auto time_field = [&](const mag::FieldOptions& f, std::vector<Vec3>* H) {
+    mag::FieldWorkspace ws;
+    std::vector<double> ms;
+    for (int r = 0; r < o.field_repeat + 1; ++r) {  // the first builds the workspace: not timed
+      const auto t0 = Clock::now();
+      mag::compute_fields(s, f, H, nullptr, &ws);
+      if (r > 0) ms.push_back(ms_since(t0));
+    }
+    return median(ms);
+  };
+  mag::FieldOptions direct = sn.dyn.field;
+  direct.solver = mag::FieldSolver::Direct;
+  const double direct_ms = time_field(direct, &H_ref);
+  bh << "direct,0," << direct_ms << ",0,0\n";
+  summary["field"].push_back({{"solver", "direct"}, {"ms_per_eval", direct_ms}});
+  std::printf("field: direct %.3f ms per evaluation (%zu moments)\n", direct_ms, s.size());
+  for (double th : thetas) {
+    mag::FieldOptions f = direct;
+    f.solver = mag::FieldSolver::BarnesHut;
+    f.bh_theta = th;
+    std::vector<Vec3> H;
+    const double ms = time_field(f, &H);
+    double num = 0, den = 0, mx = 0;
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      const double d = (H[j] - H_ref[j]).norm(), h = H_ref[j].norm();
+      num += d * d;
+      den += h * h;
+      if (h > 0) mx = std::max(mx, d / h);
+    }
+    const double rms = den > 0 ? std::sqrt(num / den) : 0.0;
+    bh << "barnes-hut," << th << ',' << ms << ',' << rms << ',' << mx << '\n';
+    summary["field"].push_back({{"solver", "barnes-hut"}, {"theta", th}, {"ms_per_eval", ms},
+                                {"rms_rel_err", rms}, {"max_rel_err", mx}});
+    std::printf("field: barnes-hut θ = %.2f: %.3f ms per evaluation, relative error RMS %.2e, "
+                "max %.2e\n", th, ms, rms, mx);
+  }
+  summary["seconds"] = ms_since(t_all) / 1000;
+  std::ofstream(o.out + "/snapshot_speed.json") << summary.dump(2) << "\n";
+  std::printf("snapshot-speed: wrote %s/speed_sakura.csv, sakura_bh.csv, snapshot_speed.json "
+              "(%.1f s)\n", o.out.c_str(), ms_since(t_all) / 1000);
   return 0;
 }
 
@@ -420,12 +946,38 @@ int main(int argc, char** argv) {
   cs->add_option("--out", sp.out, "output directory")->capture_default_str();
   cs->add_option("--iters", sp.iters, "iterations per run")->check(CLI::PositiveNumber)->capture_default_str();
   cs->add_option("--repeat", sp.repeat, "timing repeats (median)")->check(CLI::PositiveNumber)->capture_default_str();
+  ToleranceOpts to;
+  auto* ct = app.add_subcommand(
+      "tolerance", "convergence tolerance against force error on a sakura_tree snapshot, and "
+                   "against a scene's outcome (beyond the paper)");
+  ct->add_option("--out", to.out, "output directory")->capture_default_str();
+  add_option(ct, &to.snap);
+  ct->add_option("--methods", to.methods, "comma list or all, relaxed on the snapshot")->capture_default_str();
+  ct->add_option("--tols", to.tols, "comma list of tolerances (max_j |M_j − f(H_j)|/Ms_j)")->capture_default_str();
+  ct->add_option("--max-iter", to.max_iter, "iteration cap per relaxation on the snapshot")->check(CLI::PositiveNumber)->capture_default_str();
+  ct->add_option("--repeat", to.repeat, "timing repeats per relaxation (median)")->check(CLI::PositiveNumber)->capture_default_str();
+  ct->add_flag("--cold,!--no-cold", to.cold, "also relax from M = 0, besides the engine's warm start (default: on)");
+  ct->add_option("--outcome-scene", to.outcome_scene, "registry scene run with ours-realigned at each --outcome-tols")->capture_default_str();
+  ct->add_option("--outcome-seconds", to.outcome_seconds, "simulated time of each outcome run (s)")->check(CLI::PositiveNumber)->capture_default_str();
+  ct->add_option("--outcome-tols", to.outcome_tols, "comma list of tolerances for the outcome runs")->capture_default_str();
+  SnapshotSpeedOpts ss;
+  auto* css = app.add_subcommand(
+      "snapshot-speed", "e_M against wall time per method and per Newton step on a sakura_tree "
+                        "snapshot; Barnes–Hut field error against time (beyond the paper)");
+  css->add_option("--out", ss.out, "output directory")->capture_default_str();
+  add_option(css, &ss.snap);
+  css->add_option("--iters", ss.iters, "sweeps per dynamics run")->check(CLI::PositiveNumber)->capture_default_str();
+  css->add_option("--repeat", ss.repeat, "timing repeats per dynamics run (median)")->check(CLI::PositiveNumber)->capture_default_str();
+  css->add_option("--thetas", ss.thetas, "comma list of Barnes–Hut opening angles θ")->capture_default_str();
+  css->add_option("--field-repeat", ss.field_repeat, "timed field evaluations per solver (median)")->check(CLI::PositiveNumber)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     if (*c8) return run_fig8(f8);
     if (*c9) return run_fig9(f9);
     if (*c10) return run_fig10(f10);
     if (*cs) return run_speed(sp);
+    if (*ct) return run_tolerance(to);
+    if (*css) return run_snapshot_speed(ss);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "experiments: %s\n", e.what());
     return 1;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # tools/report.sh — rebuilds the experiment report from scratch into out/report/: the paper's
-# Table 1 and Figs. 8, 9, 10, the uniqueness figure (§6.3), speed against accuracy and
-# scaling, as CSV/JSON + PNG charts + index.md. About 10–25 minutes on 2 cores.
+# Table 1 and Figs. 8, 9, 10, the uniqueness figure (§6.3), speed against accuracy (crystal_balls
+# and a sakura_tree snapshot), tolerance against force error, and scaling, as CSV/JSON + PNG
+# charts + index.md. About 10–25 minutes on 2 cores.
 #
 #   bash tools/report.sh            reduced Fig. 9 grid (11 × 101 cells × 64 directions)
 #   bash tools/report.sh --quick    shorter benchmark windows, no 10,000-ball scaling point
@@ -27,6 +28,11 @@ echo "== Fig. 8 and uniqueness";  $bin/experiments fig8 --out "$out" | tee "$out
 echo "== Fig. 9 (reduced grid)";  $bin/experiments fig9 --out "$out" --methods all | tee "$out/fig9.txt"
 echo "== Fig. 10";                $bin/experiments fig10 --out "$out" | tee "$out/fig10.txt"
 echo "== speed against accuracy"; $bin/experiments speed --out "$out" | tee "$out/speed.txt"
+# both step sakura_tree to the same snapshot (cached in $out/sakura_snapshot.json): ~1 min together
+echo "== speed against accuracy, sakura_tree snapshot"
+$bin/experiments snapshot-speed --out "$out" | tee "$out/snapshot_speed.txt"
+echo "== tolerance against force error and scene outcome"
+$bin/experiments tolerance --out "$out" | tee "$out/tolerance.txt"
 if [ "$quick" -eq 1 ]; then
   echo "== Table 1 and scaling (quick)"
   $bin/bench --warmup 100 --steps 50 --scaling 250,1000,2500 --json "$out/bench.json" | tee "$out/bench.txt"
