@@ -59,6 +59,16 @@ void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
   compute_fields(eff, field, &ws->H_eff_src, &ws->J_eff_src, &ws->field);
   // F_j = ½ (F_zeeman,j + μ0 J̃_j m_j)
   for (long j = 0; j < n; ++j) (*F)[j] = 0.5 * ((*F)[j] + classic_force(set.moment(j), ws->J_eff_src[j]));
+  if (!tau) return;
+  // the torque of a permanent moment from the same pair energy
+  //   U_ij = −½ μ0 [m̃_j·H_i(m_i) + m_j·H_i(m̃_i)],  m̃ = m for permanent moments:
+  //   τ_j = ½ μ0 m_j × (H_j + H̃_j),  H̃ the field of the effective moments.
+  // Induced moments get none: M is re-induced, it does not turn with its ball. With the
+  // literal τ = μ0 m × H the magnet of falling_magnet (0.25 kg, iron on it) tumbles and rolls
+  // off across the ground: 432 balls, 1 s, final KE 0.55 J → 0.27 J with this torque.
+  for (long j = 0; j < n; ++j)
+    if (set.kind[j] == MomentKind::Permanent)
+      (*tau)[j] = 0.5 * kMu0 * set.moment(j).cross(ws->H[j] + ws->H_eff_src[j]);
 }
 
 }  // namespace magsim::mag

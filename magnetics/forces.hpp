@@ -28,7 +28,11 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// symmetric force applies each pair's antisymmetric part,
 ///   F_j = ½ μ0 Σ_i [J(r_ji; m_i) m̃_j + J(r_ji; m̃_i) m_j] = ½ (F_zeeman,j + μ0 J̃_j m_j),
 /// J̃ the Jacobian of the field of the effective moments: one more field evaluation, and
-/// Σ_j F_j = 0 exactly (Algorithm 1 computes F "for each pair of magnetic moments").
+/// Σ_j F_j = 0 exactly (Algorithm 1 computes F "for each pair of magnetic moments"). The
+/// torque on a permanent moment is that of the same pair energy, τ_j = ½ μ0 m_j × (H_j + H̃_j)
+/// (induced moments: none, M does not turn with its body). Angular momentum is then
+/// conserved up to the torques the pair energy would put on induced moments,
+/// ½ μ0 Σ m_j × H̃_j over induced j (a test measures it).
 void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
                     const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
                     std::vector<Vec3>* tau, std::vector<Vec3>* F_classic = nullptr,

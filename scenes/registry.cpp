@@ -222,21 +222,22 @@ SceneDesc falling_magnet(const SceneParams& p) {
 
 // ---------------------------------------------------------------------------------------
 // sakura_tree — 2500 iron balls (radius 4 mm) fall from a 50×50 grid 40 cm up onto a static
-// tree of capsules whose 8 branch ends each carry a 20 A·m² permanent moment.
+// tree of capsules whose 8 branch ends each carry a NdFeB sphere magnet (radius 1.2 cm,
+// 7.2 A·m², |H| = 2M/3 ≈ 0.42 Ms at its poles).
 SceneDesc sakura_tree(const SceneParams& p) {
   SceneDesc s;
   s.name = "sakura_tree";
   s.description = "2500 iron balls fall onto a tree whose branch ends are magnets";
   s.modelling_level =
-      "1 induced moment per ball; tree: static capsules (trunk, 2 levels of branches), 1 "
-      "permanent moment at each of the 8 branch ends";
+      "1 induced moment per ball; tree: static capsules (trunk, 2 levels of branches); 8 "
+      "static sphere magnets at the branch ends, 1 permanent moment each";
   const int N = p.count > 0 ? p.count : 2500;
   const double r = 0.004;
   BodyDesc tree;
   tree.name = "tree";
   tree.type = BodyType::Static;
-  tree.magnet = true;
   tree.color = {0.45f, 0.30f, 0.18f};
+  std::vector<BodyDesc> tips;
   auto capsule = [&](const Vec3& a, const Vec3& b, double rad) {
     const Vec3 d = b - a;
     ShapeDesc sh;
@@ -256,15 +257,28 @@ SceneDesc sakura_tree(const SceneParams& p) {
       const double b = a + 0.45 * k;
       const Vec3 tip = mid + Vec3(0.06 * std::cos(b), 0.06 * std::sin(b), 0.05);
       capsule(mid, tip, 0.004);
+      // the branch end: a NdFeB sphere magnet of radius Rt magnetized along the branch, a
+      // static body of its own (coloured as a magnet). Its collider keeps iron at ≥ Rt + r
+      // from the dipole: a 20 A·m² point moment on a 4 mm twig let a ball reach 8 mm from
+      // it (|H| ≈ 4 Ms, ≈ 1 kN on a 2 g ball), which no 1 ms rigid step resolves.
+      const double Rt = 0.012;  // (m)
+      BodyDesc tipm;
+      tipm.name = "tip_magnet_" + std::to_string(tips.size());
+      tipm.type = BodyType::Static;
+      tipm.magnet = true;
+      tipm.position = tip;
+      tipm.color = kMagnetRed;
+      tipm.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(Rt, Rt, Rt)});
       MomentDesc m;
       m.permanent = true;
-      m.volume = 1e-6;
-      m.offset = tip;
-      m.moment = 20.0 * p.strength * (tip - mid).normalized();
-      tree.moments.push_back(m);
+      m.volume = sphere_volume(Rt);
+      m.moment = kNdFeBM * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 7.2 A·m²
+      tipm.moments.push_back(m);
+      tips.push_back(tipm);
     }
   }
   s.bodies.push_back(tree);
+  for (const BodyDesc& t : tips) s.bodies.push_back(t);
   const int side = static_cast<int>(std::ceil(std::sqrt(std::min(N, 2500))));
   for (int k = 0; k < N; ++k) {
     const int layer = k / (side * side), in = k % (side * side);
