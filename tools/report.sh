@@ -35,7 +35,7 @@ echo "== tolerance against force error and scene outcome"
 $bin/experiments tolerance --out "$out" | tee "$out/tolerance.txt"
 if [ "$quick" -eq 1 ]; then
   echo "== Table 1 and scaling (quick)"
-  $bin/bench --warmup 100 --steps 50 --scaling 250,1000,2500 --json "$out/bench.json" | tee "$out/bench.txt"
+  $bin/bench --warmup 300 --steps 50 --scaling 250,1000,2500 --json "$out/bench.json" | tee "$out/bench.txt"
 else
   echo "== Table 1 and scaling"
   $bin/bench --json "$out/bench.json" | tee "$out/bench.txt"
