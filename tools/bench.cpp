@@ -7,6 +7,7 @@
 // auto: Barnes–Hut from --bh-threshold moments on), or --field-solver when only that is given.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
+#include "tools/field_flags.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -17,7 +18,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace eng = magsim::engine;
 namespace mag = magsim::mag;
@@ -61,27 +64,16 @@ struct Window {
   std::string error;
 };
 
-// Field options from the command line; unset ones keep the scene's.
-struct FieldChoice {
-  bool has_solver = false, has_theta = false, has_threshold = false;
-  mag::FieldSolver solver = mag::FieldSolver::Direct;
-  double theta = 0.3;
-  int threshold = 2500;
-  void apply(mag::FieldOptions* f) const {
-    if (has_solver) f->solver = solver;
-    if (has_theta) f->bh_theta = theta;
-    if (has_threshold) f->auto_threshold = threshold;
-  }
-};
-
 Window measure(const std::string& scene, mag::Method method, int count, int warmup, int steps,
-               int threads, const FieldChoice& field) {
+               int threads, const magsim::tools::FieldFlags& field,
+               std::optional<mag::FieldSolver> solver = std::nullopt) {
   magsim::scenes::SceneParams p;
   p.count = count;
   eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
   d.options.method = method;
   if (threads > 0) d.options.threads = threads;
   field.apply(&d.options.magnetics.field);
+  if (solver) d.options.magnetics.field.solver = *solver;
   eng::Simulation sim(d);
   Window w;
   w.moments = sim.model().nmoment;
@@ -137,9 +129,8 @@ int main(int argc, char** argv) {
   // on the tree (t ≈ 0.28 s), falling_magnet's magnet on the pile (0.13 s), balls_up's balls
   // on the magnet; the scaling runs' 300 likewise
   int warmup = 400, steps = 100, threads = 0, scaling_steps = 30, scaling_warmup = 300;
-  std::string field_solver = "direct", scaling_solver = "auto";
-  double bh_theta = mag::FieldOptions{}.bh_theta;
-  int bh_threshold = mag::FieldOptions{}.auto_threshold;
+  std::string scaling_solver = "auto";
+  magsim::tools::FieldFlags field;
   app.add_option("--scenes", scenes, "comma list of registry scenes")->capture_default_str();
   app.add_option("--methods", methods, "comma list of methods")->capture_default_str();
   app.add_option("--warmup", warmup, "steps before the window")->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -149,38 +140,23 @@ int main(int argc, char** argv) {
   app.add_option("--scaling-methods", scaling_methods, "methods for the scaling runs")->capture_default_str();
   app.add_option("--scaling-steps", scaling_steps, "window of each scaling run")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--scaling-warmup", scaling_warmup, "steps before each scaling window")->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--field-solver", field_solver,
-                 "direct | barnes-hut | auto: dipole-field summation of every run (default: the scene's, direct)");
-  app.add_option("--bh-theta", bh_theta, "Barnes-Hut opening angle, in (0, 1]")->capture_default_str();
-  app.add_option("--bh-threshold", bh_threshold, "auto: moments from which Barnes-Hut is used")
-      ->check(CLI::Range(0, 1000000000))->capture_default_str();
+  field.add(&app, "direct | barnes-hut | auto: dipole-field summation of every run (default: the scene's, direct)");
   app.add_option("--scaling-solver", scaling_solver,
                  "field solver of the scaling runs (default auto, or --field-solver when only that is given)")
       ->capture_default_str();
   app.add_option("--json", out, "where to write the JSON")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  FieldChoice table_field, scaling_field;
-  if (!mag::parse_field_solver(field_solver, &table_field.solver)) {
-    std::fprintf(stderr, "bench: --field-solver: unknown solver '%s' (direct, barnes-hut, auto)\n", field_solver.c_str());
+  // the scaling runs: --scaling-solver, or --field-solver when only that is given
+  if (!app.count("--scaling-solver") && field.has_solver()) scaling_solver = field.solver;
+  mag::FieldSolver scaling_field;
+  try {
+    field.check();
+    if (field.has_solver()) magsim::tools::FieldFlags::parse(field.solver, "--field-solver");
+    scaling_field = magsim::tools::FieldFlags::parse(scaling_solver, "--scaling-solver");
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "bench: %s\n", e.what());
     return 2;
-  }
-  table_field.has_solver = app.count("--field-solver") > 0;
-  if (!app.count("--scaling-solver") && app.count("--field-solver")) scaling_solver = field_solver;
-  if (!mag::parse_field_solver(scaling_solver, &scaling_field.solver)) {
-    std::fprintf(stderr, "bench: --scaling-solver: unknown solver '%s' (direct, barnes-hut, auto)\n", scaling_solver.c_str());
-    return 2;
-  }
-  scaling_field.has_solver = true;
-  if (!(bh_theta > 0 && bh_theta <= 1)) {
-    std::fprintf(stderr, "bench: --bh-theta: the Barnes-Hut opening angle must be in (0, 1], got %g\n", bh_theta);
-    return 2;
-  }
-  for (FieldChoice* f : {&table_field, &scaling_field}) {
-    f->has_theta = app.count("--bh-theta") > 0;
-    f->theta = bh_theta;
-    f->has_threshold = app.count("--bh-threshold") > 0;
-    f->threshold = bh_threshold;
   }
 
   std::vector<std::pair<std::string, mag::Method>> ms;
@@ -207,17 +183,17 @@ int main(int argc, char** argv) {
   doc["scaling_warmup_steps"] = scaling_warmup;
   doc["scaling_window_steps"] = scaling_steps;
   // requested for the Table 1 runs (each run records the one used)
-  doc["field_solver"] = app.count("--field-solver") ? field_solver : "scene default";
+  doc["field_solver"] = field.has_solver() ? field.solver : "scene default";
   doc["scaling_solver"] = scaling_solver;
-  doc["bh_theta"] = bh_theta;
-  doc["bh_threshold"] = bh_threshold;
+  doc["bh_theta"] = field.theta;
+  doc["bh_threshold"] = field.threshold;
   doc["runs"] = json::array();
   std::printf("%-15s %-15s %9s %9s %9s %9s %7s %6s %-10s   paper T_i/T_f/T_r (ms per frame)\n",
               "scene", "method", "T_i", "T_f", "T_r", "total", "iters", "cap%", "solver");
   for (const std::string& s : split(scenes)) {
     std::map<std::string, double> ti;  // method name → median T_i
     for (const auto& [name, m] : ms) {
-      const Window w = measure(s, m, 0, warmup, steps, threads, table_field);
+      const Window w = measure(s, m, 0, warmup, steps, threads, field);
       json r = window_json(w);
       r["scene"] = s;
       r["method"] = name;
@@ -256,7 +232,7 @@ int main(int argc, char** argv) {
       if (!mag::parse_method(m, &x)) continue;
       for (const std::string& n : split(scaling)) {
         const int N = std::stoi(n);
-        const Window w = measure("sakura_tree", x, N, scaling_warmup, scaling_steps, threads, scaling_field);
+        const Window w = measure("sakura_tree", x, N, scaling_warmup, scaling_steps, threads, field, scaling_field);
         json row = {{"balls", N}, {"method", m}, {"total_ms", w.total},
                     {"T_i", w.T_i}, {"T_f", w.T_f}, {"T_r", w.T_r},
                     {"iterations_median", w.iters}, {"moments", w.moments},

@@ -15,6 +15,7 @@
 #endif
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
+#include "tools/field_flags.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -28,6 +29,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -59,9 +61,7 @@ struct Args {
   double dt_m = 0.0;
   double tol = 0.0;
   int max_iter = 0;
-  std::string field_solver;
-  double bh_theta = 0.0;
-  int bh_threshold = 0;
+  magsim::tools::FieldFlags field;
   bool list = false;
 };
 
@@ -104,17 +104,11 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--tol")) s.options.magnetics.tol = a.tol;
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
   mag::FieldOptions& f = s.options.magnetics.field;
-  if (app.count("--field-solver") && !mag::parse_field_solver(a.field_solver, &f.solver))
-    throw UsageError("--field-solver: unknown solver '" + a.field_solver + "' (direct, barnes-hut, auto)");
-  if (app.count("--bh-theta")) {
-    if (!(a.bh_theta > 0 && a.bh_theta <= 1)) {
-      char got[32];
-      std::snprintf(got, sizeof got, "%g", a.bh_theta);
-      throw UsageError(std::string("--bh-theta: the Barnes-Hut opening angle must be in (0, 1], got ") + got);
-    }
-    f.bh_theta = a.bh_theta;
+  try {
+    a.field.apply(&f);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
   }
-  if (app.count("--bh-threshold")) f.auto_threshold = a.bh_threshold;
   if (const std::string e = mag::validate(f); !e.empty()) throw UsageError("field options: " + e);
   s.options.magnetics.method = s.options.method;
   return s;
@@ -488,13 +482,10 @@ int main(int argc, char** argv) {
   app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
   app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(CLI::PositiveNumber);
   app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(CLI::Range(1, 1000000000));
-  app.add_option("--field-solver", a.field_solver,
-                 "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
-                 "and the forces alike (default: the scene's, direct); auto = Barnes-Hut from "
-                 "--bh-threshold moments on");
-  app.add_option("--bh-theta", a.bh_theta, "Barnes-Hut opening angle, in (0, 1] (default 0.3)");
-  app.add_option("--bh-threshold", a.bh_threshold, "auto: moments from which Barnes-Hut is used (default 2500)")
-      ->check(CLI::Range(0, 1000000000));
+  a.field.add(&app,
+              "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
+              "and the forces alike (default: the scene's, direct); auto = Barnes-Hut from "
+              "--bh-threshold moments on");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
 
   try {

@@ -1,0 +1,61 @@
+// tools/field_flags.hpp — the dipole-field flags shared by magsim-scene and bench:
+// --field-solver direct|barnes-hut|auto, --bh-theta θ, --bh-threshold N. Flags not given
+// leave the scene's FieldOptions as they are.
+#pragma once
+
+#include "magnetics/dipole_field.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace magsim::tools {
+
+struct FieldFlags {
+  std::string solver;
+  double theta = mag::FieldOptions{}.bh_theta;
+  int threshold = mag::FieldOptions{}.auto_threshold;
+  CLI::Option* solver_opt = nullptr;
+  CLI::Option* theta_opt = nullptr;
+  CLI::Option* threshold_opt = nullptr;
+
+  void add(CLI::App* app, const std::string& solver_help) {
+    solver_opt = app->add_option("--field-solver", solver, solver_help);
+    theta_opt = app->add_option("--bh-theta", theta, "Barnes-Hut opening angle, in (0, 1]")
+                    ->capture_default_str();
+    threshold_opt = app->add_option("--bh-threshold", threshold, "auto: moments from which Barnes-Hut is used")
+                        ->check(CLI::Range(0, 1000000000))
+                        ->capture_default_str();
+  }
+  bool has_solver() const { return solver_opt && solver_opt->count() > 0; }
+
+  /// Parses a solver name; throws std::invalid_argument naming `flag`.
+  static mag::FieldSolver parse(const std::string& name, const char* flag) {
+    mag::FieldSolver s;
+    if (!mag::parse_field_solver(name, &s))
+      throw std::invalid_argument(std::string(flag) + ": unknown solver '" + name + "' (direct, barnes-hut, auto)");
+    return s;
+  }
+
+  /// Throws std::invalid_argument when --bh-theta is outside (0, 1] (θ = 0, the library's
+  /// exact limit, is for tests: it is the direct sum at tree cost).
+  void check() const {
+    if (theta_opt && theta_opt->count() && !(theta > 0 && theta <= 1)) {
+      char got[32];
+      std::snprintf(got, sizeof got, "%g", theta);
+      throw std::invalid_argument(std::string("--bh-theta: the Barnes-Hut opening angle must be in (0, 1], got ") + got);
+    }
+  }
+
+  /// Applies the flags given on the command line to f (after check()).
+  void apply(mag::FieldOptions* f) const {
+    check();
+    if (has_solver()) f->solver = parse(solver, "--field-solver");
+    if (theta_opt && theta_opt->count()) f->bh_theta = theta;
+    if (threshold_opt && threshold_opt->count()) f->auto_threshold = threshold;
+  }
+};
+
+}  // namespace magsim::tools
