@@ -2,7 +2,8 @@
 //
 // The moments are sorted along a Morton curve and split into an octree whose leaves hold at
 // most `bh_leaf_size` moments. Every cell carries the multipole of its nonzero source moments
-// about their |m|-weighted centre c (d_i = p_i − c):
+// about a centre c that does not depend on the moments — their centre weighted by their
+// largest possible moments, V_i Ms_i (induced) or |m_i| (permanent) (d_i = p_i − c):
 //   M = Σ m_i (dipole), S = sym Σ d_i ⊗ m_i (quadrupole order),
 //   O = sym Σ d_i ⊗ d_i ⊗ m_i (octupole order, with bh_order = 2).
 // Targets come in groups of at most `bh_group_size` (a small subtree, or sibling subtrees
@@ -18,8 +19,18 @@
 // J = ∂h/∂x of the same series; the first omitted term is smaller than the kept ones by
 // about (b/R)^(order+1). A cell that may hold a source of a target's group gives the group
 // its field only; its Jacobian comes from deeper cells (or exactly, leaf by leaf), so
-// same-group sources stay out of J exactly. Work per group does not depend on the thread
-// that does it, so results are deterministic whatever the thread count.
+// same-group sources stay out of J exactly. Only bodies of several moments count here: a
+// one-moment body (a ball) can only meet itself, and an accepted cell never holds a target.
+// Work per group does not depend on the thread that does it, so results are deterministic
+// whatever the thread count.
+//
+// Reuse: the magnetization solvers evaluate the fields 5–35 times per step at the same
+// positions with other moments. The tree, its centres and radii, the target groups and the
+// interaction lists (node ids) depend on the positions, groups, which moments are nonzero,
+// V Ms / |m_perm| and the leaf and group sizes (and the lists on θ and on whether J is
+// wanted) only; while those are bitwise unchanged, a call redoes just the multipoles (one
+// bottom-up pass) and the sums. A fresh call builds everything and then runs the same code,
+// so reused and fresh results are bitwise the same.
 #include "magnetics/barnes_hut.hpp"
 
 #include "magnetics/field_kernel.hpp"
@@ -30,6 +41,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace magsim::mag {
@@ -47,13 +59,15 @@ struct Node {
   int nchild = 0;
   int t0 = 0, t1 = 0;  // range of moments in tree order
   int s0 = 0, s1 = 0;  // range of nonzero sources in the packed, tree-ordered arrays
-  double c[3] = {0, 0, 0};  // expansion centre (|m|-weighted)
-  double b = 0;             // max |p_i − c| over the sources (m)
-  double wsum = 0;          // Σ |m_i|
+  double c[3] = {0, 0, 0};   // expansion centre (see node_geometry)
+  double gc[3] = {0, 0, 0};  // centroid of the sources
+  double w = 0;              // Σ w_i, the sources' largest possible |m_i| (A·m²)
+  double b = 0;              // max |p_i − c| over the sources (m)
   double M[3] = {0, 0, 0};  // Σ m_i
   double Q[3][3] = {};      // Q[a][c] = Σ m_ia d_ic (full, for shifting)
   double X[3][6] = {};      // X[a][ce] = Σ m_ia d_ic d_ie (symmetric in c, e; for shifting)
-  int gmin = std::numeric_limits<int>::max(), gmax = -1;  // groups (≥ 0) of the sources
+  // groups (≥ 0) of the sources that belong to a body of several moments
+  int gmin = std::numeric_limits<int>::max(), gmax = -1;
   std::uint64_t gmask = 0;
 };
 
@@ -72,7 +86,8 @@ struct Group {
   int t0 = 0, t1 = 0;        // range of moments in tree order
   double tc[3] = {0, 0, 0};  // bounding sphere of the targets
   double tb = 0;
-  int tgmin = std::numeric_limits<int>::max(), tgmax = -1;  // their groups (≥ 0)
+  // their groups (≥ 0) that are bodies of several moments
+  int tgmin = std::numeric_limits<int>::max(), tgmax = -1;
   std::uint64_t tgmask = 0;
 };
 
@@ -138,6 +153,12 @@ struct NearBuffer {
   }
 };
 
+// A group's interaction lists as node ids: far cells (field and Jacobian / field only /
+// Jacobian only) and near leaves (exact: field and Jacobian / Jacobian only).
+struct GroupLists {
+  std::vector<int> far_hj, far_h, far_j, near, near_j;
+};
+
 struct ThreadScratch {
   NearBuffer near, near_j;                  // exact sources: H and J / J only
   CellBuffer far_hj, far_h, far_j;          // cells: field and Jacobian / field only / J only
@@ -149,6 +170,21 @@ struct ThreadScratch {
 }  // namespace
 
 struct BarnesHutWorkspace {
+  // The geometry (tree, groups, lists) is kept while the positions, groups, the set of
+  // nonzero moments, the largest possible moments (V Ms, |m| of permanent ones; they set
+  // the expansion centres) and the leaf and group sizes stay bitwise the same (key_*); the lists
+  // also depend on θ and on whether J is wanted (one set of lists for each).
+  bool tree_valid = false;
+  std::vector<Vec3> key_pos;
+  std::vector<std::int32_t> key_grp;
+  std::vector<std::uint8_t> key_nz, nz;  // moment i nonzero (cached / this call)
+  std::vector<double> key_w, w;          // its largest possible |m_i| (cached / this call)
+  int key_leaf = 0, key_group = 0;
+  bool lists_valid[2] = {false, false};  // [want_J]
+  double lists_theta[2] = {0, 0};
+  std::vector<GroupLists> lists[2];
+  std::vector<std::uint8_t> shared;  // moment i belongs to a body of several moments
+
   std::vector<std::pair<std::uint64_t, int>> keys;  // (Morton code, moment), sorted
   std::vector<int> order;                           // tree position → moment index
   std::vector<int> src_prefix;                      // nonzero sources before tree position
@@ -157,11 +193,18 @@ struct BarnesHutWorkspace {
   std::vector<double> cells;  // (nodes × kCellFields) the kernel's view of each cell
   std::vector<Group> groups;
   detail::SourceBuffer src;  // nonzero sources in tree order (not padded)
+  std::vector<double> src_w;  // their largest possible |m_i|
   std::vector<ThreadScratch> threads;
   BarnesHutStats stats;
 };
 
 BarnesHutWorkspace* new_barnes_hut_workspace() { return new BarnesHutWorkspace; }
+
+void barnes_hut_forget_geometry(FieldWorkspace* ws) {
+  if (!ws->bh) return;
+  ws->bh->tree_valid = false;
+  ws->bh->lists_valid[0] = ws->bh->lists_valid[1] = false;
+}
 void BarnesHutWorkspaceDeleter::operator()(BarnesHutWorkspace* p) const { delete p; }
 
 BarnesHutStats barnes_hut_stats(const FieldWorkspace& ws) {
@@ -228,57 +271,74 @@ void add_moment(const double* d, const double* m, Node* nd) {
   }
 }
 
-// Multipole of a leaf from its sources; of an inner node by shifting its children's:
-// with d = d' + δ (δ = c_child − c): Q_ac += Q'_ac + M'_a δ_c,
-// X_ace += X'_ace + δ_c Q'_ae + δ_e Q'_ac + δ_c δ_e M'_a.
-void node_multipole(const detail::SourceBuffer& s, BarnesHutWorkspace* ws, int id) {
+// Geometry of a node (once per tree): its expansion centre c, the centre of its nonzero
+// sources weighted by their largest possible moments w_i (V_i Ms_i induced, |m_i|
+// permanent) — of a leaf directly, of an inner node from its children's centres and total
+// weights; the plain centroid where every w_i = 0. Unlike the |m|-weighted centre it does not
+// move when the magnetizations change, so the tree and the lists stay valid, and unlike the
+// plain centroid it stays near a strong magnet inside the cell. b = max |p_i − c|; and the
+// groups of its sources that are bodies of several moments.
+void node_geometry(BarnesHutWorkspace* ws, int id) {
+  const detail::SourceBuffer& s = ws->src;
   Node& nd = ws->nodes[id];
-  double pc[3] = {0, 0, 0}, gc[3] = {0, 0, 0};
-  double w = 0;
+  if (nd.s1 == nd.s0) return;
+  double wc[3] = {0, 0, 0}, gc[3] = {0, 0, 0}, w = 0;
   if (nd.child < 0) {
     for (int k = nd.s0; k < nd.s1; ++k) {
-      const double a = std::sqrt(s.mx[k] * s.mx[k] + s.my[k] * s.my[k] + s.mz[k] * s.mz[k]);
-      w += a;
-      pc[0] += a * s.x[k]; pc[1] += a * s.y[k]; pc[2] += a * s.z[k];
+      const double wk = ws->src_w[k];
+      w += wk;
+      wc[0] += wk * s.x[k]; wc[1] += wk * s.y[k]; wc[2] += wk * s.z[k];
       gc[0] += s.x[k]; gc[1] += s.y[k]; gc[2] += s.z[k];
-      add_group(static_cast<int>(s.grp[k]), &nd.gmin, &nd.gmax, &nd.gmask);
+      const int i = static_cast<int>(s.id[k]);
+      if (ws->shared[i]) add_group(static_cast<int>(s.grp[k]), &nd.gmin, &nd.gmax, &nd.gmask);
     }
   } else {
     for (int c = nd.child; c < nd.child + nd.nchild; ++c) {
       const Node& ch = ws->nodes[c];
-      w += ch.wsum;
-      for (int a = 0; a < 3; ++a) pc[a] += ch.wsum * ch.c[a];
+      const double cnt = ch.s1 - ch.s0;
+      w += ch.w;
+      for (int a = 0; a < 3; ++a) {
+        wc[a] += ch.w * ch.c[a];
+        gc[a] += cnt * ch.gc[a];
+      }
       nd.gmin = std::min(nd.gmin, ch.gmin);
       nd.gmax = std::max(nd.gmax, ch.gmax);
       nd.gmask |= ch.gmask;
     }
   }
-  nd.wsum = w;
-  if (nd.s1 == nd.s0) return;
-  // |m|-weighted centre (the geometric one if every |m| underflows)
-  if (w > 0) {
-    for (int a = 0; a < 3; ++a) nd.c[a] = pc[a] / w;
-  } else if (nd.child < 0) {
-    for (int a = 0; a < 3; ++a) nd.c[a] = gc[a] / (nd.s1 - nd.s0);
-  } else {
-    for (int c = nd.child; c < nd.child + nd.nchild; ++c)
-      if (ws->nodes[c].s1 > ws->nodes[c].s0) {
-        for (int a = 0; a < 3; ++a) nd.c[a] = ws->nodes[c].c[a];
-        break;
-      }
+  nd.w = w;
+  for (int a = 0; a < 3; ++a) {
+    nd.gc[a] = gc[a] / (nd.s1 - nd.s0);
+    nd.c[a] = w > 0 ? wc[a] / w : nd.gc[a];
   }
   double b2 = 0;
   for (int k = nd.s0; k < nd.s1; ++k) {
     const double d[3] = {s.x[k] - nd.c[0], s.y[k] - nd.c[1], s.z[k] - nd.c[2]};
     b2 = std::max(b2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if (nd.child < 0) {
+  }
+  nd.b = std::sqrt(b2);
+}
+
+// Multipole of a leaf from its sources (d_i = p_i − c); of an inner node by shifting its
+// children's: with d = d' + δ (δ = c_child − c): Q_ac += Q'_ac + M'_a δ_c,
+// X_ace += X'_ace + δ_c Q'_ae + δ_e Q'_ac + δ_c δ_e M'_a.
+void node_multipole(const detail::SourceBuffer& s, BarnesHutWorkspace* ws, int id) {
+  Node& nd = ws->nodes[id];
+  for (int a = 0; a < 3; ++a) {
+    nd.M[a] = 0;
+    for (int c = 0; c < 3; ++c) nd.Q[a][c] = 0;
+    for (int c = 0; c < 6; ++c) nd.X[a][c] = 0;
+  }
+  if (nd.s1 == nd.s0) return;
+  if (nd.child < 0) {
+    for (int k = nd.s0; k < nd.s1; ++k) {
+      const double d[3] = {s.x[k] - nd.c[0], s.y[k] - nd.c[1], s.z[k] - nd.c[2]};
       const double m[3] = {s.mx[k], s.my[k], s.mz[k]};
       for (int a = 0; a < 3; ++a) nd.M[a] += m[a];
       add_moment(d, m, &nd);
     }
+    return;
   }
-  nd.b = std::sqrt(b2);
-  if (nd.child < 0) return;
   for (int c = nd.child; c < nd.child + nd.nchild; ++c) {
     const Node& ch = ws->nodes[c];
     if (ch.s1 == ch.s0) continue;
@@ -326,7 +386,7 @@ void close_group(const MomentSet& set, BarnesHutWorkspace* ws, int t0, int t1) {
     const int i = ws->order[t];
     lo = lo.cwiseMin(set.position[i]);
     hi = hi.cwiseMax(set.position[i]);
-    add_group(set.group[i], &g.tgmin, &g.tgmax, &g.tgmask);
+    if (ws->shared[i]) add_group(set.group[i], &g.tgmin, &g.tgmax, &g.tgmask);
   }
   const Vec3 c = 0.5 * (lo + hi);
   double b2 = 0;
@@ -362,8 +422,36 @@ void make_groups(const MomentSet& set, BarnesHutWorkspace* ws, int id, int G) {
   close_group(set, ws, p0, p1);
 }
 
+// Which moments belong to a body (group ≥ 0) of several moments. Only those can bring a
+// target's own body into a far cell: a cell accepted for a group of targets lies outside
+// the targets' bounding sphere, so it never holds a target itself (a one-moment body).
+void find_shared(const MomentSet& set, BarnesHutWorkspace* ws) {
+  const std::size_t n = set.size();
+  ws->shared.assign(n, 0);
+  std::int32_t gmax = -1;
+  for (std::int32_t g : set.group) gmax = std::max(gmax, g);
+  if (gmax < 0) return;
+  if (static_cast<std::size_t>(gmax) <= 16 * n + 1024) {
+    std::vector<int> count(static_cast<std::size_t>(gmax) + 1, 0);
+    for (std::int32_t g : set.group)
+      if (g >= 0) ++count[g];
+    for (std::size_t i = 0; i < n; ++i) ws->shared[i] = set.group[i] >= 0 && count[set.group[i]] > 1;
+    return;
+  }
+  std::vector<std::int32_t> sorted(set.group);
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    if (set.group[i] < 0) continue;
+    const auto r = std::equal_range(sorted.begin(), sorted.end(), set.group[i]);
+    ws->shared[i] = r.second - r.first > 1;
+  }
+}
+
+// The geometry: Morton order, octree, node centres and radii, target groups. Depends on the
+// positions, groups, which moments are nonzero, and the leaf and group sizes only.
 void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspace* ws) {
   const int n = static_cast<int>(set.size());
+  find_shared(set, ws);
   // Morton codes on the bounding cube, sorted (ties by index: deterministic)
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
   for (const Vec3& p : set.position) {
@@ -385,35 +473,34 @@ void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspac
   ws->order.resize(n);
   for (int i = 0; i < n; ++i) ws->order[i] = ws->keys[i].second;
 
-  // nonzero sources in tree order
+  // nonzero sources in tree order (moments filled in by update_multipoles)
   ws->src.clear();
+  ws->src_w.clear();
   ws->src_prefix.resize(n + 1);
   for (int t = 0; t < n; ++t) {
     ws->src_prefix[t] = static_cast<int>(ws->src.size());
     const int i = ws->order[t];
-    const Vec3 m = set.moment(i);
-    if (m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0) continue;
+    if (!ws->nz[i]) continue;
     const Vec3& p = set.position[i];
-    ws->src.push(p.x(), p.y(), p.z(), m.x(), m.y(), m.z(), i, set.group[i]);
+    ws->src.push(p.x(), p.y(), p.z(), 0.0, 0.0, 0.0, i, set.group[i]);
+    ws->src_w.push_back(ws->w[i]);
   }
   ws->src_prefix[n] = static_cast<int>(ws->src.size());
 
   ws->nodes.assign(1, Node{});
   ws->nodes[0].t1 = n;
   split_node(ws, 0, 0, std::max(1, opt.bh_leaf_size));
-  // multipoles bottom-up (children have larger indices than their parent)
+  // geometry bottom-up (children have larger indices than their parent)
   const int nn = static_cast<int>(ws->nodes.size());
   for (int id = nn - 1; id >= 0; --id) {
     Node& nd = ws->nodes[id];
     nd.s0 = ws->src_prefix[nd.t0];
     nd.s1 = ws->src_prefix[nd.t1];
-    node_multipole(ws->src, ws, id);
+    node_geometry(ws, id);
   }
-  ws->cells.resize(static_cast<std::size_t>(nn) * kCellFields);
   ws->hot.resize(nn);
   for (int id = 0; id < nn; ++id) {
     const Node& nd = ws->nodes[id];
-    cell_fields(nd, &ws->cells[std::size_t(id) * kCellFields]);
     ws->hot[id] = NodeHot{{nd.c[0], nd.c[1], nd.c[2]}, nd.b, nd.child, nd.nchild, nd.s0, nd.s1,
                           nd.gmin, nd.gmax, nd.gmask};
   }
@@ -421,33 +508,43 @@ void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspac
   make_groups(set, ws, 0, std::max(1, opt.bh_group_size));
 }
 
+// The moments of this call: sources' moments, multipoles bottom-up, the kernel's cells.
+void update_multipoles(const MomentSet& set, BarnesHutWorkspace* ws) {
+  detail::SourceBuffer& s = ws->src;
+  const int ns = static_cast<int>(s.size());
+  for (int k = 0; k < ns; ++k) {
+    const Vec3 m = set.moment(static_cast<std::size_t>(s.id[k]));
+    s.mx[k] = m.x(); s.my[k] = m.y(); s.mz[k] = m.z();
+  }
+  const int nn = static_cast<int>(ws->nodes.size());
+  for (int id = nn - 1; id >= 0; --id) node_multipole(s, ws, id);
+  ws->cells.resize(static_cast<std::size_t>(nn) * kCellFields);
+  for (int id = 0; id < nn; ++id) cell_fields(ws->nodes[id], &ws->cells[std::size_t(id) * kCellFields]);
+}
+
 // ---- interaction lists -------------------------------------------------------------------
 
+// May the cell hold a source of a body of several moments that one of the targets belongs to?
 bool groups_overlap(const NodeHot& src, const Group& g) {
   return src.gmax >= 0 && g.tgmax >= 0 && src.gmin <= g.tgmax && g.tgmin <= src.gmax &&
          (src.gmask & g.tgmask) != 0;
 }
 
-void gather_sources(const detail::SourceBuffer& s, const NodeHot& nd, NearBuffer* out) {
-  out->append(s, nd.s0, nd.s1);
-}
-
 // Walks the tree for one target group and fills its interaction lists (see file comment).
 void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, bool want_J,
-                 ThreadScratch* th) {
-  th->near.clear();
-  th->near_j.clear();
-  th->far_hj.clear();
-  th->far_h.clear();
-  th->far_j.clear();
-  th->stack.clear();
-  th->stack.emplace_back(0, false);
-  while (!th->stack.empty()) {
-    const auto [id, j_only] = th->stack.back();
-    th->stack.pop_back();
+                 std::vector<std::pair<int, bool>>* stack, GroupLists* gl) {
+  gl->far_hj.clear();
+  gl->far_h.clear();
+  gl->far_j.clear();
+  gl->near.clear();
+  gl->near_j.clear();
+  stack->clear();
+  stack->emplace_back(0, false);
+  while (!stack->empty()) {
+    const auto [id, j_only] = stack->back();
+    stack->pop_back();
     const NodeHot& nd = ws.hot[id];
     if (nd.s1 == nd.s0) continue;
-    const double* cell = &ws.cells[std::size_t(id) * kCellFields];
     const double dx = nd.c[0] - g.tc[0], dy = nd.c[1] - g.tc[1], dz = nd.c[2] - g.tc[2];
     const double R = std::sqrt(dx * dx + dy * dy + dz * dz);
     // multipole acceptance: every target of the group sees the cell under an angle < θ;
@@ -456,29 +553,47 @@ void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, boo
     const bool overlap = want_J && groups_overlap(nd, g);
     if (accept) {
       if (!want_J) {
-        th->far_h.push(cell);
+        gl->far_h.push_back(id);
         continue;
       }
       if (!overlap) {
-        (j_only ? th->far_j : th->far_hj).push(cell);
+        (j_only ? gl->far_j : gl->far_hj).push_back(id);
         continue;
       }
       // the cell may hold sources of the group's own rigid bodies: its field from the
       // expansion, its Jacobian from deeper down
-      if (!j_only) th->far_h.push(cell);
+      if (!j_only) gl->far_h.push_back(id);
     }
     if (nd.child < 0) {
-      gather_sources(ws.src, nd, (accept || j_only) ? &th->near_j : &th->near);
+      ((accept || j_only) ? gl->near_j : gl->near).push_back(id);
       continue;
     }
     const bool child_j_only = j_only || accept;
-    for (int c = nd.child + nd.nchild - 1; c >= nd.child; --c) th->stack.emplace_back(c, child_j_only);
+    for (int c = nd.child + nd.nchild - 1; c >= nd.child; --c) stack->emplace_back(c, child_j_only);
   }
-  th->near.pad();
-  th->near_j.pad();
-  th->far_hj.pad();
-  th->far_h.pad();
-  th->far_j.pad();
+}
+
+// Copies a group's listed cells and near sources (with this call's moments) into the
+// thread's kernel buffers, padded.
+void gather(const BarnesHutWorkspace& ws, const GroupLists& gl, ThreadScratch* th) {
+  th->near.clear();
+  th->near_j.clear();
+  th->far_hj.clear();
+  th->far_h.clear();
+  th->far_j.clear();
+  auto cells = [&ws](const std::vector<int>& ids, CellBuffer* cb) {
+    for (int id : ids) cb->push(&ws.cells[std::size_t(id) * kCellFields]);
+    cb->pad();
+  };
+  cells(gl.far_hj, &th->far_hj);
+  cells(gl.far_h, &th->far_h);
+  cells(gl.far_j, &th->far_j);
+  auto leaves = [&ws](const std::vector<int>& ids, NearBuffer* nb) {
+    for (int id : ids) nb->append(ws.src, ws.hot[id].s0, ws.hot[id].s1);
+    nb->pad();
+  };
+  leaves(gl.near, &th->near);
+  leaves(gl.near_j, &th->near_j);
 }
 
 // ---- far-cell kernel ---------------------------------------------------------------------
@@ -737,10 +852,40 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   if (J) J->resize(n);
   ws->stats = BarnesHutStats{};
   if (n == 0) return;
-  build_tree(set, opt, ws);
+  // reuse the geometry when nothing it depends on changed (bitwise)
+  ws->nz.resize(n);
+  ws->w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 m = set.moment(i);
+    ws->nz[i] = !(m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0);
+    ws->w[i] = set.kind[i] == MomentKind::Induced ? set.volume[i] * set.Ms[i] : m.norm();
+  }
+  const int leaf = std::max(1, opt.bh_leaf_size), gsize = std::max(1, opt.bh_group_size);
+  const bool same_tree =
+      ws->tree_valid && static_cast<int>(ws->key_pos.size()) == n && ws->key_leaf == leaf &&
+      ws->key_group == gsize && ws->key_nz == ws->nz &&
+      std::memcmp(ws->key_w.data(), ws->w.data(), n * sizeof(double)) == 0 &&
+      std::memcmp(ws->key_pos.data(), set.position.data(), n * sizeof(Vec3)) == 0 &&
+      std::memcmp(ws->key_grp.data(), set.group.data(), n * sizeof(std::int32_t)) == 0;
+  if (!same_tree) {
+    ws->tree_valid = false;
+    ws->lists_valid[0] = ws->lists_valid[1] = false;
+    build_tree(set, opt, ws);
+    ws->key_pos = set.position;
+    ws->key_grp = set.group;
+    ws->key_nz = ws->nz;
+    ws->key_w = ws->w;
+    ws->key_leaf = leaf;
+    ws->key_group = gsize;
+    ws->tree_valid = true;
+  }
+  const auto t_tree = std::chrono::steady_clock::now();
+  update_multipoles(set, ws);
   const auto t_built = std::chrono::steady_clock::now();
   const double eps2 = opt.softening * opt.softening;
   const bool want_J = J != nullptr;
+  const int mode = want_J ? 1 : 0;
+  const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.bh_theta;
   const int order = opt.bh_order;
   const int nthreads = omp_get_max_threads();
   if (static_cast<int>(ws->threads.size()) < nthreads) ws->threads.resize(nthreads);
@@ -749,6 +894,8 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
     th.lists_s = 0;
   }
   const long ngroups = static_cast<long>(ws->groups.size());
+  std::vector<GroupLists>& lists = ws->lists[mode];
+  if (new_lists) lists.resize(ngroups);
 #pragma omp parallel
   {
     ThreadScratch& th = ws->threads[omp_get_thread_num()];
@@ -756,8 +903,9 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
     for (long l = 0; l < ngroups; ++l) {
       const Group& g = ws->groups[l];
       const auto t_l0 = std::chrono::steady_clock::now();
-      build_lists(*ws, g, opt.bh_theta, want_J, &th);
+      if (new_lists) build_lists(*ws, g, opt.bh_theta, want_J, &th.stack, &lists[l]);
       th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
+      gather(*ws, lists[l], &th);
       const detail::SourceView vn = th.near.view(), vj = th.near_j.view();
       const long nt = g.t1 - g.t0;
       th.near_pairs += nt * static_cast<long>(vn.n + vj.n);
@@ -786,15 +934,20 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
       }
     }
   }
+  ws->lists_valid[mode] = true;
+  ws->lists_theta[mode] = opt.bh_theta;
   const auto t_end = std::chrono::steady_clock::now();
   BarnesHutStats& st = ws->stats;
   st.nodes = static_cast<int>(ws->nodes.size());
   st.groups = static_cast<int>(ngroups);
+  st.reused_tree = same_tree;
+  st.reused_lists = !new_lists;
   for (const ThreadScratch& th : ws->threads) {
     st.near_pairs_per_target += double(th.near_pairs) / n;
     st.far_cells_per_target += double(th.far_cells) / n;
     st.lists_s += th.lists_s;
   }
+  st.tree_s = std::chrono::duration<double>(t_tree - t_start).count();
   st.build_s = std::chrono::duration<double>(t_built - t_start).count();
   st.eval_s = std::chrono::duration<double>(t_end - t_built).count();
 }

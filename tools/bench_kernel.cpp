@@ -8,10 +8,17 @@
 // spaced targets and extrapolated to all N (printed as "sampled"), and Barnes–Hut is checked
 // on those targets. Never a pass/fail test: timings depend on the machine and its load.
 //
-// Moments: iron balls (radius 4 mm, Ms = 1.6 MA/m) in two layouts — "pile", a packed heap
+// Barnes–Hut is timed twice: "fresh" (the octree and interaction lists built for the call,
+// as after the bodies moved) and "reused" (the same positions with other moments, as the
+// magnetization solvers call it 5–35 times per step: only the multipoles are redone).
+//
+// Moments: iron balls (radius 4 mm, Ms = 1.6 MA/m) in three layouts — "pile", a packed heap
 // (an FCC packing of touching balls filled layer by layer on a square footprint, about three
-// times as wide as high, like the scenes' piles) and "cloud", a uniform random cloud at 5 %
-// volume fraction. Magnetized as a scene would be (--moments scene, the default: a strong
+// times as wide as high, like the scenes' piles), "cloud", a uniform random cloud at 5 %
+// volume fraction, and "sheet", a square grid of balls in one horizontal plane, spacing 2.05
+// radii (sakura_tree's falling sheet, or a carpet on the ground). With --groups ball every
+// ball is its own rigid body (group id = its index, as the engine numbers bodies), else no
+// moment has a group. Magnetized as a scene would be (--moments scene, the default: a strong
 // magnet above the middle, each ball at f(H_magnet + H0)) or independently at random
 // (--moments random, the hard case for multipoles).
 #include "magnetics/barnes_hut.hpp"
@@ -26,6 +33,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -102,6 +110,31 @@ mag::MomentSet pile(int n, unsigned seed, bool scene) {
   std::mt19937 rng(seed);
   magnetize(&s, &rng, scene);
   return s;
+}
+
+// A square grid of balls in the plane z = 0, spacing 2.05 radii, filled row by row.
+mag::MomentSet sheet(int n, unsigned seed, bool scene) {
+  const double d = 2.05 * kRadius;
+  const int nx = static_cast<int>(std::ceil(std::sqrt(double(n))));
+  mag::MomentSet s;
+  for (int k = 0; k < n; ++k) s.add_induced(Vec3((k % nx) * d, (k / nx) * d, 0.0), ball_volume(), kMs);
+  std::mt19937 rng(seed);
+  magnetize(&s, &rng, scene);
+  return s;
+}
+
+// The same positions and groups with every moment changed (|M| scaled by 0.9…1.1 per
+// moment, zero moments stay zero): what a magnetization solver's next sweep hands over.
+mag::MomentSet other_moments(const mag::MomentSet& a, unsigned seed) {
+  mag::MomentSet b = a;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> f(0.9, 1.1);
+  for (std::size_t j = 0; j < b.size(); ++j)
+    if (b.kind[j] == mag::MomentKind::Induced) {
+      const Vec3 M = f(rng) * b.M[j];
+      b.set_magnetization(j, M.norm() > b.Ms[j] ? Vec3(b.M[j]) : M);
+    }
+  return b;
 }
 
 // Uniform random balls at 5 % volume fraction, no two overlapping (grid-hashed rejection).
@@ -206,13 +239,16 @@ int main(int argc, char** argv) {
   std::vector<int> threads{1, 2};
   std::vector<double> thetas{0.3, 0.5, 0.7};
   std::vector<std::string> layouts{"pile", "cloud"};
-  std::string json_path, moments = "scene";
+  std::string json_path, moments = "scene", groups = "none";
   int repeat = 3, sample = 2048, full_max = 20000, leaf = 64, group = 32, order = 2;
   bool portable = false, no_bh = false;
   app.add_option("--sizes", sizes, "numbers of moments")->delimiter(',');
   app.add_option("--threads", threads, "thread counts")->delimiter(',');
   app.add_option("--theta", thetas, "Barnes–Hut opening angles θ")->delimiter(',');
-  app.add_option("--layouts", layouts, "pile, cloud")->delimiter(',');
+  app.add_option("--layouts", layouts, "pile, cloud, sheet")->delimiter(',');
+  app.add_option("--groups", groups, "none (no moment has a group, the default) or ball "
+                 "(every ball its own rigid body, as in the engine)")
+      ->check(CLI::IsMember({"none", "ball"}));
   app.add_option("--moments", moments, "scene (smooth, a magnet above) or random")
       ->check(CLI::IsMember({"scene", "random"}));
   app.add_option("--json", json_path, "write the results as JSON to this file");
@@ -242,17 +278,23 @@ int main(int argc, char** argv) {
   out["stat"] = stat;
   out["clock"] = clock;
   out["moments"] = moments;
+  out["groups"] = groups;
   out["results"] = json::array();
   std::printf("# AVX-512 kernel: %s; %s of %d repeats; pairs/s = targets × sources / time\n",
               mag::detail::simd_kernel_active() ? "yes" : "no", g_use_min ? "min" : "median", repeat);
   for (const std::string& layout : layouts) {
-    if (layout != "pile" && layout != "cloud") {
-      std::fprintf(stderr, "unknown layout %s (pile, cloud)\n", layout.c_str());
+    if (layout != "pile" && layout != "cloud" && layout != "sheet") {
+      std::fprintf(stderr, "unknown layout %s (pile, cloud, sheet)\n", layout.c_str());
       return 2;
     }
     for (int n : sizes) {
       const bool scene = moments == "scene";
-      const mag::MomentSet set = layout == "pile" ? pile(n, 7, scene) : cloud(n, 7, scene);
+      mag::MomentSet set = layout == "pile"    ? pile(n, 7, scene)
+                           : layout == "sheet" ? sheet(n, 7, scene)
+                                               : cloud(n, 7, scene);
+      if (groups == "ball")
+        for (std::size_t j = 0; j < set.size(); ++j) set.group[j] = static_cast<std::int32_t>(j);
+      const mag::MomentSet set_b = other_moments(set, 11);
       const bool sampled = n > full_max;
       const std::vector<int> tgt = sample_targets(n, sampled ? sample : n);
       const double frac = double(tgt.size()) / n;  // sampled share of the targets
@@ -300,11 +342,35 @@ int main(int argc, char** argv) {
           bh.bh_leaf_size = leaf;
           bh.bh_group_size = group;
           bh.bh_order = order;
-          const double tb_h = median_seconds(repeat, [&] { mag::compute_fields(set, bh, &H, nullptr, &ws); });
+          // fresh: the geometry forgotten before every call (tree and lists built)
+          auto fresh = [&](bool jac) {
+            mag::barnes_hut_forget_geometry(&ws);
+            mag::compute_fields(set, bh, &H, jac ? &J : nullptr, &ws);
+          };
+          const double tb_h = median_seconds(repeat, [&] { fresh(false); });
           const Errors eh = errors(tgt, H, nullptr, Href, nullptr);
-          const double tb_hj = median_seconds(repeat, [&] { mag::compute_fields(set, bh, &H, &J, &ws); });
+          const double tb_hj = median_seconds(repeat, [&] { fresh(true); });
           const Errors ej = errors(tgt, H, &J, Href, &Jref);
           const mag::BarnesHutStats st = mag::barnes_hut_stats(ws);
+          // reused: the same positions, the moments alternating between two sets
+          auto time_reused = [&](bool jac) {
+            int k = 0;
+            mag::compute_fields(set, bh, &H, jac ? &J : nullptr, &ws);
+            return median_seconds(repeat, [&] {
+              mag::compute_fields(++k % 2 ? set_b : set, bh, &H, jac ? &J : nullptr, &ws);
+            });
+          };
+          const double tr_h = time_reused(false), tr_hj = time_reused(true);
+          const mag::BarnesHutStats st_r = mag::barnes_hut_stats(ws);
+          // reuse gives bitwise what a fresh evaluation gives
+          std::vector<Vec3> Hr, Hf;
+          std::vector<Mat3> Jr, Jf;
+          mag::compute_fields(set, bh, &Hr, &Jr, &ws);
+          mag::compute_fields(set_b, bh, &Hr, &Jr, &ws);
+          mag::barnes_hut_forget_geometry(&ws);
+          mag::compute_fields(set_b, bh, &Hf, &Jf, &ws);
+          const bool same = std::memcmp(Hr.data(), Hf.data(), Hr.size() * sizeof(Vec3)) == 0 &&
+                            std::memcmp(Jr.data(), Jf.data(), Jr.size() * sizeof(Mat3)) == 0;
           rec["barnes_hut"].push_back({{"theta", theta}, {"leaf", leaf}, {"group", group}, {"order", order},
                                        {"time_H_s", tb_h}, {"time_HJ_s", tb_hj},
                                        {"speedup_H", td_h / tb_h}, {"speedup_HJ", td_hj / tb_hj},
@@ -315,14 +381,22 @@ int main(int argc, char** argv) {
                                        {"near_pairs_per_target", st.near_pairs_per_target},
                                        {"far_cells_per_target", st.far_cells_per_target},
                                        {"build_s", st.build_s}, {"lists_s", st.lists_s},
-                                       {"eval_s", st.eval_s}});
+                                       {"eval_s", st.eval_s},
+                                       {"time_H_reused_s", tr_h}, {"time_HJ_reused_s", tr_hj},
+                                       {"speedup_H_reused", td_h / tr_h},
+                                       {"speedup_HJ_reused", td_hj / tr_hj},
+                                       {"reused_build_s", st_r.build_s},
+                                       {"reused_eval_s", st_r.eval_s},
+                                       {"reuse_bitwise_identical", same}});
           std::printf("%-5s n=%6d threads=%d BH θ=%.2f: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "
                       "err max %.2e rms %.2e | H+J %8.3f ms (×%5.1f) J err max %.2e rms %.2e "
-                      "| near %.0f far %.0f per target | build %.2f lists %.2f eval %.2f ms\n",
+                      "| near %.0f far %.0f per target | build %.2f lists %.2f eval %.2f ms "
+                      "| reused: H %8.3f ms (×%5.1f) H+J %8.3f ms (×%5.1f)%s\n",
                       layout.c_str(), n, nt, theta, tb_h * 1e3, td_h / tb_h, pairs / tb_h, eh.h_max,
                       eh.h_rms, tb_hj * 1e3, td_hj / tb_hj, ej.j_max, ej.j_rms,
                       st.near_pairs_per_target, st.far_cells_per_target, st.build_s * 1e3,
-                      st.lists_s * 1e3, st.eval_s * 1e3);
+                      st.lists_s * 1e3, st.eval_s * 1e3, tr_h * 1e3, td_h / tr_h, tr_hj * 1e3,
+                      td_hj / tr_hj, same ? "" : " NOT BITWISE AS FRESH");
         }
         std::fflush(stdout);
         out["results"].push_back(rec);

@@ -101,7 +101,7 @@ TEST_CASE("Barnes–Hut error bound at the default θ: random 3,000-moment cloud
           "[barnes-hut]") {
   // The bound stated in barnes_hut.hpp for the defaults (θ = 0.3, octupole order, leaves of
   // 64, groups of 32): relative field error RMS ≤ 1e-3, max ≤ 2e-2. Measured here: pile
-  // RMS 2.0e-4, max 3.6e-3; cloud RMS 5.7e-5, max 2.4e-3.
+  // RMS 2.6e-4, max 3.5e-3; cloud RMS 6.1e-5, max 2.7e-3.
   const FieldOptions o = bh_options(FieldOptions{}.bh_theta);
   const Errors c = bh_errors(magsim::test::sparse_cloud(3000, 2), o);
   INFO("cloud: H max " << c.h_max << " rms " << c.h_rms << "; J max " << c.j_max << " rms "
@@ -207,6 +207,155 @@ TEST_CASE("Barnes–Hut is deterministic: bitwise the same run to run and for 1 
   CHECK(std::memcmp(a.first.data(), b.first.data(), a.first.size() * sizeof(Vec3)) == 0);
   CHECK(std::memcmp(a.second.data(), b.second.data(), a.second.size() * sizeof(Mat3)) == 0);
   CHECK(std::memcmp(b.first.data(), c.first.data(), b.first.size() * sizeof(Vec3)) == 0);
+  // geometry cached by a 2-thread call, reused by a 1-thread call: the same bits
+  MomentSet s2 = s;
+  for (std::size_t j = 0; j < s2.size(); ++j)
+    if (s2.M[j].squaredNorm() > 0) s2.set_magnetization(j, 0.7 * s2.M[j]);
+  const int saved = omp_get_max_threads();
+  FieldWorkspace ws;
+  std::vector<Vec3> H1, H2;
+  std::vector<Mat3> J1, J2;
+  omp_set_num_threads(2);
+  compute_fields(s, o, &H1, &J1, &ws);
+  compute_fields(s2, o, &H2, &J2, &ws);  // reused, 2 threads
+  omp_set_num_threads(1);
+  compute_fields(s, o, &H1, &J1, &ws);  // reused, 1 thread
+  omp_set_num_threads(saved);
+  CHECK(barnes_hut_stats(ws).reused_lists);
+  CHECK(std::memcmp(H1.data(), a.first.data(), H1.size() * sizeof(Vec3)) == 0);
+  CHECK(std::memcmp(J1.data(), a.second.data(), J1.size() * sizeof(Mat3)) == 0);
+}
+
+namespace {
+
+bool same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
+}
+bool same_bits(const std::vector<Mat3>& a, const std::vector<Mat3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Mat3)) == 0;
+}
+
+// The same positions and groups with other moments: every magnetization turned and scaled,
+// some moments zeroed (and, with keep_zeros, the zero pattern of `s` kept).
+MomentSet other_moments(const MomentSet& s, unsigned seed, bool keep_zeros) {
+  MomentSet b = s;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  for (std::size_t j = 0; j < b.size(); ++j) {
+    if (b.kind[j] != MomentKind::Induced) continue;
+    if (keep_zeros && b.M[j].squaredNorm() == 0) continue;
+    const bool zero = !keep_zeros && j % 7 == 3;
+    b.set_magnetization(j, zero ? Vec3::Zero().eval()
+                                : Vec3(0.4 * b.Ms[j] * Vec3(g(rng), g(rng), g(rng)).normalized()));
+  }
+  return b;
+}
+
+}  // namespace
+
+TEST_CASE("Barnes–Hut reuses its geometry when only the moments change, bitwise as fresh",
+          "[barnes-hut]") {
+  // A then B (other moments, same positions and groups) with one workspace, against B in a
+  // fresh workspace: bitwise equal, for H alone and H with J, and the tree and lists reused.
+  for (int layout = 0; layout < 2; ++layout) {
+    const MomentSet a = layout == 0 ? letters() : magsim::test::fcc_pile(1500);
+    for (bool keep_zeros : {true, false}) {
+      const MomentSet b = other_moments(a, 5, keep_zeros);
+      for (bool jac : {false, true}) {
+        FieldOptions o = bh_options(0.4);
+        o.softening = 5e-4;
+        FieldWorkspace ws, fresh;
+        std::vector<Vec3> Ha, Hb, Hf;
+        std::vector<Mat3> Ja, Jb, Jf;
+        compute_fields(a, o, &Ha, jac ? &Ja : nullptr, &ws);
+        compute_fields(b, o, &Hb, jac ? &Jb : nullptr, &ws);
+        const BarnesHutStats st = barnes_hut_stats(ws);
+        compute_fields(b, o, &Hf, jac ? &Jf : nullptr, &fresh);
+        INFO("layout " << layout << ", zeros kept " << keep_zeros << ", J " << jac);
+        CHECK(st.reused_tree == keep_zeros);  // a new set of nonzero moments is a new tree
+        CHECK(st.reused_lists == keep_zeros);
+        CHECK(same_bits(Hb, Hf));
+        if (jac) CHECK(same_bits(Jb, Jf));
+        CHECK_FALSE(same_bits(Ha, Hb));  // the moments did change the field
+        // and back to A: still what a fresh workspace gives
+        compute_fields(a, o, &Hb, jac ? &Jb : nullptr, &ws);
+        CHECK(same_bits(Hb, Ha));
+        if (jac) CHECK(same_bits(Jb, Ja));
+      }
+    }
+  }
+}
+
+TEST_CASE("Barnes–Hut rebuilds its geometry when positions, groups or options change",
+          "[barnes-hut]") {
+  const MomentSet a = letters();
+  const FieldOptions o = bh_options(0.4);
+  FieldWorkspace ws;
+  std::vector<Vec3> H, Hf;
+  std::vector<Mat3> J, Jf;
+  compute_fields(a, o, &H, &J, &ws);
+  compute_fields(a, o, &H, &J, &ws);
+  CHECK(barnes_hut_stats(ws).reused_tree);
+  CHECK(barnes_hut_stats(ws).reused_lists);
+  auto check_fresh = [&](const MomentSet& s, const FieldOptions& opt, bool tree_reused) {
+    compute_fields(s, opt, &H, &J, &ws);
+    const BarnesHutStats st = barnes_hut_stats(ws);
+    CHECK(st.reused_tree == tree_reused);
+    CHECK_FALSE(st.reused_lists);
+    FieldWorkspace fresh;
+    compute_fields(s, opt, &Hf, &Jf, &fresh);
+    CHECK(same_bits(H, Hf));
+    CHECK(same_bits(J, Jf));
+  };
+  SECTION("one position moved by one ulp, then a real move") {
+    MomentSet b = a;
+    b.position[17].x() = std::nextafter(b.position[17].x(), 1.0);
+    check_fresh(b, o, false);
+    b.position[400] += Vec3(0.05, -0.02, 0.01);
+    check_fresh(b, o, false);
+  }
+  SECTION("a group changed") {
+    MomentSet b = a;
+    b.group[3] = 159;
+    check_fresh(b, o, false);
+  }
+  SECTION("θ changed: the tree stays, the lists are redone") {
+    check_fresh(a, bh_options(0.3), true);
+  }
+  SECTION("leaf size changed") {
+    FieldOptions p = o;
+    p.bh_leaf_size = 16;
+    check_fresh(a, p, false);
+  }
+  SECTION("a permanent moment's strength changed (it weights the expansion centres)") {
+    MomentSet b = a;
+    b.add_permanent(Vec3(0.2, 0.2, 0.45), 8e-6, Vec3(0, 0, -5.0));
+    compute_fields(b, o, &H, &J, &ws);
+    b.m_perm.back() *= 1.5;
+    check_fresh(b, o, false);
+  }
+}
+
+TEST_CASE("Barnes–Hut: one-moment bodies do not make J exact (same-group test)",
+          "[barnes-hut]") {
+  // Every ball its own rigid body (as the engine numbers them): J must cost what it costs
+  // without groups (far cells keep their Jacobian), and the result is the same.
+  MomentSet s = magsim::test::fcc_pile(3000);
+  FieldOptions o = bh_options(FieldOptions{}.bh_theta);
+  FieldWorkspace ws0, ws1;
+  std::vector<Vec3> H0, H1;
+  std::vector<Mat3> J0, J1;
+  compute_fields(s, o, &H0, &J0, &ws0);
+  const BarnesHutStats st0 = barnes_hut_stats(ws0);
+  for (std::size_t j = 0; j < s.size(); ++j) s.group[j] = static_cast<std::int32_t>(j);
+  compute_fields(s, o, &H1, &J1, &ws1);
+  const BarnesHutStats st1 = barnes_hut_stats(ws1);
+  INFO("near pairs per target without groups " << st0.near_pairs_per_target << ", with "
+                                               << st1.near_pairs_per_target);
+  CHECK(st1.near_pairs_per_target == st0.near_pairs_per_target);
+  CHECK(st1.far_cells_per_target == st0.far_cells_per_target);
+  CHECK(same_bits(H0, H1));
+  CHECK(same_bits(J0, J1));
 }
 
 TEST_CASE("Barnes–Hut: the AVX-512 and the portable far-cell kernels agree", "[barnes-hut]") {
