@@ -88,7 +88,9 @@ struct SimOptions {
   double cfm = 1e-9;               ///< ODE constraint force mixing
   int quickstep_iterations = 20;
   int max_contacts = 4;            ///< per geom pair
-  SpaceKind space = SpaceKind::Hash;
+  /// broad phase; sweep and prune: collide 2.3 vs 3.7 ms (hash) on sakura_tree, 2500 balls,
+  /// same contacts (they are sorted into a fixed order), so the same state hash
+  SpaceKind space = SpaceKind::SweepAndPrune;
   bool auto_disable = false;       ///< ODE auto-disable of resting bodies
   double linear_damping = 0.0;     ///< velocity decay rate c (1/s): v ← v·e^{−cΔt} per step; 0 = none
   double angular_damping = 0.0;    ///< the same for angular velocity (1/s)

@@ -15,7 +15,7 @@
 //       "method": "ours" | "ours-realigned" | "kim2018" | "damping-llg" | "exact",
 //       "dt": 1e-3, "gravity": [0,0,-9.81], "ground": true, "friction": 0.5,
 //       "restitution": 0, "erp": 0.2, "cfm": 1e-9, "quickstep_iterations": 20,
-//       "max_contacts": 4, "space": "hash" | "sap" | "simple", "auto_disable": false,
+//       "max_contacts": 4, "space": "sap" | "hash" | "simple", "auto_disable": false,
 //       "linear_damping": 0, "angular_damping": 0, "surface_layer": 0,
 //       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
 //       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]

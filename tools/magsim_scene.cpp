@@ -61,6 +61,9 @@ struct Args {
   double dt_m = 0.0;
   double tol = 0.0;
   int max_iter = 0;
+  int quickstep_iterations = 0;
+  std::string space;
+  bool auto_disable = false;
   magsim::tools::FieldFlags field;
   bool list = false;
 };
@@ -103,6 +106,14 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
   if (app.count("--tol")) s.options.magnetics.tol = a.tol;
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
+  if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
+  if (app.count("--auto-disable")) s.options.auto_disable = true;
+  if (app.count("--space")) {
+    if (a.space == "hash") s.options.space = engine::SpaceKind::Hash;
+    else if (a.space == "sap") s.options.space = engine::SpaceKind::SweepAndPrune;
+    else if (a.space == "simple") s.options.space = engine::SpaceKind::Simple;
+    else throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
+  }
   mag::FieldOptions& f = s.options.magnetics.field;
   try {
     a.field.apply(&f);
@@ -482,6 +493,11 @@ int main(int argc, char** argv) {
   app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
   app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(CLI::PositiveNumber);
   app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(CLI::Range(1, 1000000000));
+  app.add_option("--quickstep-iterations", a.quickstep_iterations,
+                 "ODE QuickStep (contact solver) iterations per rigid step (default: the scene's, 20)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
+  app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   a.field.add(&app,
               "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, direct); auto = Barnes-Hut from "
