@@ -58,7 +58,9 @@ std::vector<std::string> split(const std::string& s) {
 
 struct Window {
   double T_i = 0, T_f = 0, T_r = 0, total = 0, iters = 0, cap_frac = 0;
+  double collide = 0, quickstep = 0, contacts = 0;  ///< T_r's parts (ms) and contact joints
   int moments = 0;
+  int quickstep_iterations = 0;  ///< ODE QuickStep iterations of the scene
   std::string solver;  ///< the field solver used (Auto resolved for the scene's moment count)
   bool failed = false;
   std::string error;
@@ -79,7 +81,8 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   w.moments = sim.model().nmoment;
   w.solver = mag::field_solver_name(
       mag::resolve_solver(sim.model().options.magnetics.field, static_cast<std::size_t>(w.moments)));
-  std::vector<double> ti, tf, tr, tot, it;
+  w.quickstep_iterations = sim.model().options.quickstep_iterations;
+  std::vector<double> ti, tf, tr, tot, it, co, qs, nc;
   int caps = 0;
   try {
     for (int k = 0; k < warmup + steps; ++k) {
@@ -89,6 +92,9 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
       ti.push_back(pr.T_i);
       tf.push_back(pr.T_f);
       tr.push_back(pr.T_r);
+      co.push_back(pr.collide_ms);
+      qs.push_back(pr.quickstep_ms);
+      nc.push_back(pr.contacts);
       tot.push_back(pr.T_i + pr.T_f + pr.T_r);
       it.push_back(pr.iterations);
       caps += pr.cap_hit;
@@ -100,6 +106,9 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   w.T_i = median(ti);
   w.T_f = median(tf);
   w.T_r = median(tr);
+  w.collide = median(co);
+  w.quickstep = median(qs);
+  w.contacts = median(nc);
   w.total = median(tot);
   w.iters = median(it);
   w.cap_frac = ti.empty() ? 0 : static_cast<double>(caps) / ti.size();
@@ -110,7 +119,9 @@ json window_json(const Window& w) {
   json j = {{"timing_ms", {{"T_i", {{"median", w.T_i}}}, {"T_f", {{"median", w.T_f}}},
                            {"T_r", {{"median", w.T_r}}}, {"total", {{"median", w.total}}}}},
             {"iterations_median", w.iters}, {"cap_hit_fraction", w.cap_frac},
-            {"field_solver", w.solver}, {"moments", w.moments}};
+            {"field_solver", w.solver}, {"moments", w.moments},
+            {"T_r_parts_ms", {{"collide", {{"median", w.collide}}}, {"quickstep", {{"median", w.quickstep}}}}},
+            {"contacts_median", w.contacts}, {"quickstep_iterations", w.quickstep_iterations}};
   if (w.failed) j["error"] = w.error;
   return j;
 }
@@ -210,7 +221,8 @@ int main(int argc, char** argv) {
                     r["paper_ms_per_frame"]["T_f"].get<double>(),
                     r["paper_ms_per_frame"]["T_r"].get<double>());
       if (w.failed) std::printf("   FAILED: %s", w.error.c_str());
-      std::printf("\n");
+      std::printf("\n%-15s %-15s T_r = collide %.3f + QuickStep %.3f ms (%d iterations, %.0f contacts)\n", "", "",
+                  w.collide, w.quickstep, w.quickstep_iterations, w.contacts);
       std::fflush(stdout);
       ti[name] = w.T_i;
     }
@@ -236,11 +248,12 @@ int main(int argc, char** argv) {
         json row = {{"balls", N}, {"method", m}, {"total_ms", w.total},
                     {"T_i", w.T_i}, {"T_f", w.T_f}, {"T_r", w.T_r},
                     {"iterations_median", w.iters}, {"moments", w.moments},
-                    {"solver", w.solver}, {"solver_requested", scaling_solver}};
+                    {"solver", w.solver}, {"solver_requested", scaling_solver},
+                    {"collide", w.collide}, {"quickstep", w.quickstep}, {"contacts_median", w.contacts}};
         if (w.failed) row["error"] = w.error;
         doc["scaling"].push_back(row);
-        std::printf("scaling sakura_tree N=%-6d %-15s total %9.3f ms (T_i %.3f, T_f %.3f, T_r %.3f), %.0f iterations, %s%s%s\n",
-                    N, m.c_str(), w.total, w.T_i, w.T_f, w.T_r, w.iters, w.solver.c_str(),
+        std::printf("scaling sakura_tree N=%-6d %-15s total %9.3f ms (T_i %.3f, T_f %.3f, T_r %.3f = collide %.3f + QuickStep %.3f, %.0f contacts), %.0f iterations, %s%s%s\n",
+                    N, m.c_str(), w.total, w.T_i, w.T_f, w.T_r, w.collide, w.quickstep, w.contacts, w.iters, w.solver.c_str(),
                     w.failed ? "  FAILED: " : "", w.failed ? w.error.c_str() : "");
         std::fflush(stdout);
       }
