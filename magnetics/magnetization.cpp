@@ -112,7 +112,6 @@ void rotate_toward(const Vec3& h_hat, double c_dt, double Ms, ThetaIntegrator in
   const double cos_t = std::clamp(m_hat.dot(h_hat), -1.0, 1.0);
   Vec3 e = m_hat - cos_t * h_hat;  // in-plane direction ⊥ H_eff
   double sin_t = e.norm();
-  const double theta = std::atan2(sin_t, cos_t);
   if (sin_t < 1e-300) {
     if (cos_t > 0) return;  // already on H_eff
     e = other - other.dot(h_hat) * h_hat;  // antiparallel: leave on the pair's side
@@ -120,7 +119,19 @@ void rotate_toward(const Vec3& h_hat, double c_dt, double Ms, ThetaIntegrator in
     e.normalize();
   } else {
     e /= sin_t;
+    if (integ == ThetaIntegrator::Exact && cos_t >= 0.0) {
+      // θ ≤ π/2, the sin branch of eq. 9, exactly as advance_theta but without its four
+      // trigonometric calls (they were a third of T_i in balls_up): with τ = tan(θ/2) =
+      // sin θ / (1 + cos θ), τ' = τ e^{−cΔt}, cos θ' = (1 − τ'²)/(1 + τ'²),
+      // sin θ' = 2τ'/(1 + τ'²)
+      if (!(c_dt > 0)) return;
+      const double tau = sin_t / (1.0 + cos_t) * std::exp(-c_dt);
+      const double tau2 = tau * tau, inv = 1.0 / (1.0 + tau2);
+      *Mk = Ms * (((1.0 - tau2) * inv) * h_hat + (2.0 * tau * inv) * e);
+      return;
+    }
   }
+  const double theta = std::atan2(sin_t, cos_t);
   const double th = advance_theta(theta, c_dt, integ);
   *Mk = Ms * (std::cos(th) * h_hat + std::sin(th) * e);
 }
