@@ -24,6 +24,13 @@
 // Work per group does not depend on the thread that does it, so results are deterministic
 // whatever the thread count.
 //
+// Near field in single precision (FieldOptions::bh_near_float, θ > 0): a group's near
+// sources are gathered as float arrays with positions relative to the group's centre g.tc
+// (the double difference rounded: ~1e-9 m for sources a few cm away; absolute coordinates
+// never go to float), moments in float, ids and groups as int32 for the masks, padded to
+// 16 — and summed by sum_pairs_f32 (near_kernel_f32.cpp: 16 lanes, partial sums in float,
+// totals in double). The far cells stay in double.
+//
 // Reuse: the magnetization solvers evaluate the fields 5–35 times per step at the same
 // positions with other moments. The tree, its centres and radii, the target groups and the
 // interaction lists (node ids) depend on the positions, groups, which moments are nonzero,
@@ -153,6 +160,49 @@ struct NearBuffer {
   }
 };
 
+// The same, in float for sum_pairs_f32 (FieldOptions::bh_near_float): positions relative
+// to the group's centre (converted from the double difference; never absolute coordinates
+// in float), moments, and the ids and groups as int32 for the masks.
+struct NearBufferF {
+  std::vector<float> a[6];        // x, y, z (relative to the centre), mx, my, mz
+  std::vector<std::int32_t> id, grp;
+  std::size_t n = 0;
+  void clear() { n = 0; }
+  void reserve(std::size_t m) {
+    if (m <= id.size()) return;
+    const std::size_t sz = std::max(m, 2 * id.size());
+    for (auto& v : a) v.resize(sz);
+    id.resize(sz);
+    grp.resize(sz);
+  }
+  void append(const detail::SourceBuffer& s, int s0, int s1, const double* c) {
+    reserve(n + (s1 - s0) + detail::kSourcePadF);
+    for (int k = s0; k < s1; ++k, ++n) {
+      a[0][n] = static_cast<float>(s.x[k] - c[0]);
+      a[1][n] = static_cast<float>(s.y[k] - c[1]);
+      a[2][n] = static_cast<float>(s.z[k] - c[2]);
+      a[3][n] = static_cast<float>(s.mx[k]);
+      a[4][n] = static_cast<float>(s.my[k]);
+      a[5][n] = static_cast<float>(s.mz[k]);
+      id[n] = static_cast<std::int32_t>(s.id[k]);
+      grp[n] = static_cast<std::int32_t>(s.grp[k]);  // −1: none
+    }
+  }
+  void pad() {
+    reserve(n + detail::kSourcePadF);
+    while (n % detail::kSourcePadF != 0) {
+      for (int k = 0; k < 3; ++k) a[k][n] = detail::kPadPositionF;
+      for (int k = 3; k < 6; ++k) a[k][n] = 0.0f;
+      id[n] = grp[n] = -1;
+      ++n;
+    }
+  }
+  detail::SourceViewF view() const {
+    return detail::SourceViewF{a[0].data(), a[1].data(), a[2].data(), a[3].data(),
+                               a[4].data(), a[5].data(), id.data(), grp.data(), n};
+  }
+};
+
 // A group's interaction lists as node ids: far cells (field and Jacobian / field only /
 // Jacobian only) and near leaves (exact: field and Jacobian / Jacobian only).
 struct GroupLists {
@@ -161,6 +211,7 @@ struct GroupLists {
 
 struct ThreadScratch {
   NearBuffer near, near_j;                  // exact sources: H and J / J only
+  NearBufferF nearf, nearf_j;               // the same in float (bh_near_float)
   CellBuffer far_hj, far_h, far_j;          // cells: field and Jacobian / field only / J only
   std::vector<std::pair<int, bool>> stack;  // (node, J-only)
   long near_pairs = 0, far_cells = 0;       // interaction counts (statistics)
@@ -575,9 +626,14 @@ void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, boo
 
 // Copies a group's listed cells and near sources (with this call's moments) into the
 // thread's kernel buffers, padded.
-void gather(const BarnesHutWorkspace& ws, const GroupLists& gl, ThreadScratch* th) {
+// With near_float the near sources go to the float buffers instead, relative to the group's
+// centre g.tc.
+void gather(const BarnesHutWorkspace& ws, const Group& g, const GroupLists& gl, bool near_float,
+            ThreadScratch* th) {
   th->near.clear();
   th->near_j.clear();
+  th->nearf.clear();
+  th->nearf_j.clear();
   th->far_hj.clear();
   th->far_h.clear();
   th->far_j.clear();
@@ -592,8 +648,17 @@ void gather(const BarnesHutWorkspace& ws, const GroupLists& gl, ThreadScratch* t
     for (int id : ids) nb->append(ws.src, ws.hot[id].s0, ws.hot[id].s1);
     nb->pad();
   };
-  leaves(gl.near, &th->near);
-  leaves(gl.near_j, &th->near_j);
+  auto leaves_f = [&ws, &g](const std::vector<int>& ids, NearBufferF* nb) {
+    for (int id : ids) nb->append(ws.src, ws.hot[id].s0, ws.hot[id].s1, g.tc);
+    nb->pad();
+  };
+  if (near_float) {
+    leaves_f(gl.near, &th->nearf);
+    leaves_f(gl.near_j, &th->nearf_j);
+  } else {
+    leaves(gl.near, &th->near);
+    leaves(gl.near_j, &th->near_j);
+  }
 }
 
 // ---- far-cell kernel ---------------------------------------------------------------------
@@ -883,6 +948,9 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   update_multipoles(set, ws);
   const auto t_built = std::chrono::steady_clock::now();
   const double eps2 = opt.softening * opt.softening;
+  const float eps2f = static_cast<float>(eps2);
+  // θ = 0 promises the direct sum: the near field (then everything) stays in double
+  const bool near_float = opt.bh_near_float && opt.bh_theta > 0;
   const bool want_J = J != nullptr;
   const int mode = want_J ? 1 : 0;
   const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.bh_theta;
@@ -905,10 +973,11 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
       const auto t_l0 = std::chrono::steady_clock::now();
       if (new_lists) build_lists(*ws, g, opt.bh_theta, want_J, &th.stack, &lists[l]);
       th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
-      gather(*ws, lists[l], &th);
+      gather(*ws, g, lists[l], near_float, &th);
       const detail::SourceView vn = th.near.view(), vj = th.near_j.view();
+      const detail::SourceViewF vnf = th.nearf.view(), vjf = th.nearf_j.view();
       const long nt = g.t1 - g.t0;
-      th.near_pairs += nt * static_cast<long>(vn.n + vj.n);
+      th.near_pairs += nt * static_cast<long>(vn.n + vj.n + vnf.n + vjf.n);
       th.far_cells += nt * static_cast<long>(th.far_hj.size() + th.far_h.size() + th.far_j.size());
       for (int t = g.t0; t < g.t1; ++t) {
         const int i = ws->order[t];
@@ -918,9 +987,20 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
         const detail::Target tg{p.x(), p.y(), p.z(), static_cast<double>(i), grp};
         const double pp[3] = {p.x(), p.y(), p.z()};
         double h[3] = {0, 0, 0}, jac[6] = {0, 0, 0, 0, 0, 0}, unused[3] = {0, 0, 0};
-        detail::sum_pairs(vn, tg, eps2, want_J ? detail::PairTerms::HJ : detail::PairTerms::H, h, jac);
+        const detail::PairTerms terms = want_J ? detail::PairTerms::HJ : detail::PairTerms::H;
+        if (near_float) {
+          // relative to the group's centre (the difference in double, then rounded)
+          const detail::TargetF tf{static_cast<float>(p.x() - g.tc[0]),
+                                   static_cast<float>(p.y() - g.tc[1]),
+                                   static_cast<float>(p.z() - g.tc[2]), static_cast<std::int32_t>(i),
+                                   set.group[i] >= 0 ? set.group[i] : detail::kNoGroupF};
+          detail::sum_pairs_f32(vnf, tf, eps2f, terms, h, jac);
+          if (want_J) detail::sum_pairs_f32(vjf, tf, eps2f, detail::PairTerms::HJ, unused, jac);
+        } else {
+          detail::sum_pairs(vn, tg, eps2, terms, h, jac);
+          if (want_J) detail::sum_pairs(vj, tg, eps2, detail::PairTerms::HJ, unused, jac);
+        }
         if (want_J) {
-          detail::sum_pairs(vj, tg, eps2, detail::PairTerms::HJ, unused, jac);
           far_sum<true, true>(th.far_hj, order, pp, eps2, h, jac);
           far_sum<false, true>(th.far_j, order, pp, eps2, h, jac);
         }
@@ -942,11 +1022,14 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   st.groups = static_cast<int>(ngroups);
   st.reused_tree = same_tree;
   st.reused_lists = !new_lists;
+  long near_pairs = 0, far_cells = 0;  // summed as integers: the same whatever the threads
   for (const ThreadScratch& th : ws->threads) {
-    st.near_pairs_per_target += double(th.near_pairs) / n;
-    st.far_cells_per_target += double(th.far_cells) / n;
+    near_pairs += th.near_pairs;
+    far_cells += th.far_cells;
     st.lists_s += th.lists_s;
   }
+  st.near_pairs_per_target = double(near_pairs) / n;
+  st.far_cells_per_target = double(far_cells) / n;
   st.tree_s = std::chrono::duration<double>(t_tree - t_start).count();
   st.build_s = std::chrono::duration<double>(t_built - t_start).count();
   st.eval_s = std::chrono::duration<double>(t_end - t_built).count();

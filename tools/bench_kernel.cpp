@@ -11,6 +11,10 @@
 // Barnes–Hut is timed twice: "fresh" (the octree and interaction lists built for the call,
 // as after the bodies moved) and "reused" (the same positions with other moments, as the
 // magnetization solvers call it 5–35 times per step: only the multipoles are redone).
+// --bh-near picks its near field: "double", "float" (FieldOptions::bh_near_float, the
+// default) or "both" (the default here: each θ run with both, and the float one also
+// reports its speed-up over the double one and its difference from it, "near_f32_vs_f64_*":
+// max and RMS relative over every target, as the errors above).
 //
 // Moments: iron balls (radius 4 mm, Ms = 1.6 MA/m) in three layouts — "pile", a packed heap
 // (an FCC packing of touching balls filled layer by layer on a square footprint, about three
@@ -242,6 +246,7 @@ int main(int argc, char** argv) {
   std::string json_path, moments = "scene", groups = "none";
   int repeat = 3, sample = 2048, full_max = 20000, leaf = 64, group = 32, order = 2;
   bool portable = false, no_bh = false;
+  std::string bh_near = "both";
   app.add_option("--sizes", sizes, "numbers of moments")->delimiter(',');
   app.add_option("--threads", threads, "thread counts")->delimiter(',');
   app.add_option("--theta", thetas, "Barnes–Hut opening angles θ")->delimiter(',');
@@ -268,6 +273,9 @@ int main(int argc, char** argv) {
                  "on a shared machine)")->check(CLI::IsMember({"median", "min"}));
   app.add_flag("--portable", portable, "also time the portable (non-AVX-512) direct loop");
   app.add_flag("--no-bh", no_bh, "direct sum only");
+  app.add_option("--bh-near", bh_near, "Barnes–Hut near field in float, double, or both "
+                 "(the default: both timed, float compared with double)")
+      ->check(CLI::IsMember({"float", "double", "both"}));
   CLI11_PARSE(app, argc, argv);
   g_use_min = stat == "min";
   g_cpu_clock = clock == "cpu";
@@ -279,6 +287,7 @@ int main(int argc, char** argv) {
   out["clock"] = clock;
   out["moments"] = moments;
   out["groups"] = groups;
+  out["bh_near"] = bh_near;
   out["results"] = json::array();
   std::printf("# AVX-512 kernel: %s; %s of %d repeats; pairs/s = targets × sources / time\n",
               mag::detail::simd_kernel_active() ? "yes" : "no", g_use_min ? "min" : "median", repeat);
@@ -334,14 +343,90 @@ int main(int argc, char** argv) {
           std::printf("%-5s n=%6d threads=%d portable: H %9.3f ms %.3g pairs/s | H+J %9.3f ms %.3g pairs/s\n",
                       layout.c_str(), n, nt, tp_h * 1e3, pairs / tp_h, tp_hj * 1e3, pairs / tp_hj);
         }
+        if (!no_bh && bh_near == "both") {
+          // the near-field pair kernel alone, as Barnes–Hut runs it: 32 targets against the
+          // first 2,048 moments, double (sum_pairs) against float (sum_pairs_f32, positions
+          // relative to the sources' centroid)
+          const int ns = std::min(n, 2048), nt32 = std::min(ns, 32);
+          mag::detail::SourceBuffer sd;
+          Vec3 c = Vec3::Zero();
+          for (int k = 0; k < ns; ++k) c += set.position[k] / ns;
+          std::vector<float> f[6];
+          std::vector<std::int32_t> fid, fgrp;
+          for (int k = 0; k < ns || sd.size() % mag::detail::kSourcePad != 0 ||
+                          fid.size() % mag::detail::kSourcePadF != 0; ++k) {
+            const bool real = k < ns;
+            const Vec3 p = real ? set.position[k] : Vec3::Constant(mag::detail::kPadPosition);
+            const Vec3 m = real ? set.moment(k) : Vec3::Zero();
+            const int g = real ? set.group[k] : -1;
+            if (real || sd.size() % mag::detail::kSourcePad != 0)
+              sd.push(p.x(), p.y(), p.z(), m.x(), m.y(), m.z(), real ? k : -1, g);
+            if (real || fid.size() % mag::detail::kSourcePadF != 0) {
+              const Vec3 r = real ? Vec3(p - c) : Vec3::Constant(mag::detail::kPadPositionF);
+              for (int a = 0; a < 3; ++a) f[a].push_back(static_cast<float>(r[a]));
+              for (int a = 0; a < 3; ++a) f[3 + a].push_back(static_cast<float>(m[a]));
+              fid.push_back(real ? k : -1);
+              fgrp.push_back(g < 0 ? -1 : g);
+            }
+          }
+          const mag::detail::SourceView vd{sd.x.data(), sd.y.data(), sd.z.data(), sd.mx.data(),
+                                           sd.my.data(), sd.mz.data(), sd.id.data(), sd.grp.data(),
+                                           sd.size()};
+          const mag::detail::SourceViewF vf{f[0].data(), f[1].data(), f[2].data(), f[3].data(),
+                                            f[4].data(), f[5].data(), fid.data(), fgrp.data(),
+                                            fid.size()};
+          double sink = 0;
+          auto kernel = [&](bool fl, bool jac) {
+            const auto terms = jac ? mag::detail::PairTerms::HJ : mag::detail::PairTerms::H;
+            return median_seconds(repeat, [&] {
+              for (int rep = 0; rep < 20; ++rep)
+                for (int k = 0; k < nt32; ++k) {
+                  double h[3] = {0, 0, 0}, jj[6] = {0, 0, 0, 0, 0, 0};
+                  const Vec3& p = set.position[k];
+                  const double g = set.group[k] >= 0 ? set.group[k] : std::nan("");
+                  if (fl) {
+                    const Vec3 r = p - c;
+                    const mag::detail::TargetF t{float(r.x()), float(r.y()), float(r.z()), k,
+                                                 set.group[k] >= 0 ? set.group[k] : mag::detail::kNoGroupF};
+                    mag::detail::sum_pairs_f32(vf, t, 0.0f, terms, h, jj);
+                  } else {
+                    const mag::detail::Target t{p.x(), p.y(), p.z(), double(k), g};
+                    mag::detail::sum_pairs(vd, t, 0.0, terms, h, jj);
+                  }
+                  sink += h[0] + jj[0];
+                }
+            });
+          };
+          const double kp = 20.0 * nt32 * ns;  // pairs per timed call
+          const double kd_h = kernel(false, false), kd_hj = kernel(false, true);
+          const double kf_h = kernel(true, false), kf_hj = kernel(true, true);
+          rec["near_kernel"] = {{"sources", ns}, {"pairs_per_s_H_double", kp / kd_h},
+                                {"pairs_per_s_HJ_double", kp / kd_hj},
+                                {"pairs_per_s_H_float", kp / kf_h},
+                                {"pairs_per_s_HJ_float", kp / kf_hj},
+                                {"speedup_H", kd_h / kf_h}, {"speedup_HJ", kd_hj / kf_hj}};
+          std::printf("%-5s n=%6d threads=%d near kernel alone (%d sources): H %.3g → %.3g pairs/s "
+                      "(×%.2f) | H+J %.3g → %.3g pairs/s (×%.2f) (double → float)%s\n",
+                      layout.c_str(), n, nt, ns, kp / kd_h, kp / kf_h, kd_h / kf_h, kp / kd_hj,
+                      kp / kf_hj, kd_hj / kf_hj, std::isfinite(sink) ? "" : " (non-finite!)");
+        }
         rec["barnes_hut"] = json::array();
+        std::vector<bool> near_modes;  // bh_near_float
+        if (bh_near != "float") near_modes.push_back(false);
+        if (bh_near != "double") near_modes.push_back(true);
         for (double theta : no_bh ? std::vector<double>{} : thetas) {
+         // the double-near run of this θ (for the float one's comparison)
+         double tdn_h = 0, tdn_hj = 0, tdn_rh = 0, tdn_rhj = 0;
+         std::vector<Vec3> Hdn;
+         std::vector<Mat3> Jdn;
+         for (bool near_float : near_modes) {
           mag::FieldOptions bh;
           bh.solver = mag::FieldSolver::BarnesHut;
           bh.bh_theta = theta;
           bh.bh_leaf_size = leaf;
           bh.bh_group_size = group;
           bh.bh_order = order;
+          bh.bh_near_float = near_float;
           // fresh: the geometry forgotten before every call (tree and lists built)
           auto fresh = [&](bool jac) {
             mag::barnes_hut_forget_geometry(&ws);
@@ -352,6 +437,21 @@ int main(int argc, char** argv) {
           const double tb_hj = median_seconds(repeat, [&] { fresh(true); });
           const Errors ej = errors(tgt, H, &J, Href, &Jref);
           const mag::BarnesHutStats st = mag::barnes_hut_stats(ws);
+          // float near field against double near field (the same far field), every target
+          json near_cmp = json::object();
+          std::string near_txt;
+          if (!near_float) {
+            Hdn = H;
+            Jdn = J;
+          } else if (!Hdn.empty()) {
+            const Errors d = errors(sample_targets(n, n), H, &J, Hdn, &Jdn);
+            near_cmp = {{"near_f32_vs_f64_H_max", d.h_max}, {"near_f32_vs_f64_H_rms", d.h_rms},
+                        {"near_f32_vs_f64_J_max", d.j_max}, {"near_f32_vs_f64_J_rms", d.j_rms}};
+            char buf[200];
+            std::snprintf(buf, sizeof buf, " | float vs double near: H rms %.2e max %.2e, J rms %.2e max %.2e",
+                          d.h_rms, d.h_max, d.j_rms, d.j_max);
+            near_txt = buf;
+          }
           // reused: the same positions, the moments alternating between two sets
           auto time_reused = [&](bool jac) {
             int k = 0;
@@ -371,7 +471,8 @@ int main(int argc, char** argv) {
           mag::compute_fields(set_b, bh, &Hf, &Jf, &ws);
           const bool same = std::memcmp(Hr.data(), Hf.data(), Hr.size() * sizeof(Vec3)) == 0 &&
                             std::memcmp(Jr.data(), Jf.data(), Jr.size() * sizeof(Mat3)) == 0;
-          rec["barnes_hut"].push_back({{"theta", theta}, {"leaf", leaf}, {"group", group}, {"order", order},
+          json bhrec = {{"theta", theta}, {"leaf", leaf}, {"group", group}, {"order", order},
+                                       {"bh_near", near_float ? "float" : "double"},
                                        {"time_H_s", tb_h}, {"time_HJ_s", tb_hj},
                                        {"speedup_H", td_h / tb_h}, {"speedup_HJ", td_hj / tb_hj},
                                        {"eff_pairs_per_s_H", pairs / tb_h},
@@ -387,16 +488,32 @@ int main(int argc, char** argv) {
                                        {"speedup_HJ_reused", td_hj / tr_hj},
                                        {"reused_build_s", st_r.build_s},
                                        {"reused_eval_s", st_r.eval_s},
-                                       {"reuse_bitwise_identical", same}});
-          std::printf("%-5s n=%6d threads=%d BH θ=%.2f: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "
+                                       {"reuse_bitwise_identical", same}};
+          if (!near_float) {
+            tdn_h = tb_h; tdn_hj = tb_hj; tdn_rh = tr_h; tdn_rhj = tr_hj;
+          } else if (tdn_h > 0) {
+            // speed-ups of the float near field over the double one (fresh and reused)
+            bhrec["near_f32_speedup_H"] = tdn_h / tb_h;
+            bhrec["near_f32_speedup_HJ"] = tdn_hj / tb_hj;
+            bhrec["near_f32_speedup_H_reused"] = tdn_rh / tr_h;
+            bhrec["near_f32_speedup_HJ_reused"] = tdn_rhj / tr_hj;
+            char buf[160];
+            std::snprintf(buf, sizeof buf, " | float/double near speed-up: fresh H ×%.2f H+J ×%.2f, reused H ×%.2f H+J ×%.2f",
+                          tdn_h / tb_h, tdn_hj / tb_hj, tdn_rh / tr_h, tdn_rhj / tr_hj);
+            near_txt += buf;
+          }
+          bhrec.update(near_cmp);
+          rec["barnes_hut"].push_back(bhrec);
+          std::printf("%-5s n=%6d threads=%d BH θ=%.2f %s near: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "
                       "err max %.2e rms %.2e | H+J %8.3f ms (×%5.1f) J err max %.2e rms %.2e "
                       "| near %.0f far %.0f per target | build %.2f lists %.2f eval %.2f ms "
-                      "| reused: H %8.3f ms (×%5.1f) H+J %8.3f ms (×%5.1f)%s\n",
-                      layout.c_str(), n, nt, theta, tb_h * 1e3, td_h / tb_h, pairs / tb_h, eh.h_max,
+                      "| reused: H %8.3f ms (×%5.1f) H+J %8.3f ms (×%5.1f)%s%s\n",
+                      layout.c_str(), n, nt, theta, near_float ? "float " : "double", tb_h * 1e3, td_h / tb_h, pairs / tb_h, eh.h_max,
                       eh.h_rms, tb_hj * 1e3, td_hj / tb_hj, ej.j_max, ej.j_rms,
                       st.near_pairs_per_target, st.far_cells_per_target, st.build_s * 1e3,
                       st.lists_s * 1e3, st.eval_s * 1e3, tr_h * 1e3, td_h / tr_h, tr_hj * 1e3,
-                      td_hj / tr_hj, same ? "" : " NOT BITWISE AS FRESH");
+                      td_hj / tr_hj, same ? "" : " NOT BITWISE AS FRESH", near_txt.c_str());
+         }
         }
         std::fflush(stdout);
         out["results"].push_back(rec);
