@@ -308,6 +308,7 @@ int main(int argc, char** argv) {
       const std::vector<int> tgt = sample_targets(n, sampled ? sample : n);
       const double frac = double(tgt.size()) / n;  // sampled share of the targets
       mag::FieldOptions direct;
+      direct.solver = mag::FieldSolver::Direct;  // (the default is Auto)
       mag::FieldWorkspace ws;
       // reference: the direct sum at the sampled targets
       std::vector<Vec3> Href, H;

@@ -500,7 +500,7 @@ int main(int argc, char** argv) {
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   a.field.add(&app,
               "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
-              "and the forces alike (default: the scene's, direct); auto = Barnes-Hut from "
+              "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
               "--bh-threshold moments on");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
 

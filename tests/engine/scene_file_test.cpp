@@ -130,12 +130,12 @@ TEST_CASE("scene_file: bad files fail with the file and the JSON path", "[scene_
 
 TEST_CASE("scene_file: the field solver options are read and checked", "[scene_file]") {
   const engine::SceneDesc s = scenes::parse_scene_json(
-      R"({"options": {"field_solver": "auto", "bh_theta": 0.5, "bh_threshold": 1000}, "bodies": []})", "x.json");
+      R"({"options": {"field_solver": "direct", "bh_theta": 0.5, "bh_threshold": 1000}, "bodies": []})", "x.json");
   const mag::FieldOptions& f = s.options.magnetics.field;
-  CHECK(f.solver == mag::FieldSolver::Auto);
+  CHECK(f.solver == mag::FieldSolver::Direct);
   CHECK(f.bh_theta == 0.5);
   CHECK(f.auto_threshold == 1000);
-  CHECK(scenes::parse_scene_json(kGood, "x.json").options.magnetics.field.solver == mag::FieldSolver::Direct);
+  CHECK(scenes::parse_scene_json(kGood, "x.json").options.magnetics.field.solver == mag::FieldSolver::Auto);  // the default
   CHECK(scenes::parse_scene_json(R"({"options": {"field_solver": "barnes-hut"}, "bodies": []})", "x.json")
             .options.magnetics.field.solver == mag::FieldSolver::BarnesHut);
   CHECK_THAT(error_of(R"({"options": {"field_solver": "octree"}, "bodies": []})"),
