@@ -279,7 +279,10 @@ SceneDesc sakura_tree(const SceneParams& p) {
   }
   s.bodies.push_back(tree);
   for (const BodyDesc& t : tips) s.bodies.push_back(t);
-  const int side = static_cast<int>(std::ceil(std::sqrt(std::min(N, 2500))));
+  // one square sheet, centred over the tree (above 2500 balls it only widens: stacked in
+  // sheets 3 cm apart, 10,000 balls blew up at t ≈ 0.22 s, up to 228 m/s, with the direct
+  // sum and Barnes–Hut alike — the upper sheets pile onto the balls held at the tips)
+  const int side = static_cast<int>(std::ceil(std::sqrt(N)));
   for (int k = 0; k < N; ++k) {
     const int layer = k / (side * side), in = k % (side * side);
     const int i = in % side, j = in / side;
