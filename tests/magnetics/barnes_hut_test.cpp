@@ -51,6 +51,18 @@ Errors bh_errors(const MomentSet& s, FieldOptions bh) {
   return compare(H1, J1, H0, J0);
 }
 
+// The same evaluation with the AVX-512 kernels and with the portable loops.
+Errors simd_vs_portable(const MomentSet& s, const FieldOptions& o) {
+  FieldWorkspace ws;
+  std::vector<Vec3> H1, H2;
+  std::vector<Mat3> J1, J2;
+  compute_fields(s, o, &H1, &J1, &ws);
+  detail::enable_simd_kernel(false);
+  compute_fields(s, o, &H2, &J2, &ws);
+  detail::enable_simd_kernel(true);
+  return compare(H1, J1, H2, J2);
+}
+
 FieldOptions bh_options(double theta) {
   FieldOptions o;
   o.solver = FieldSolver::BarnesHut;
@@ -364,14 +376,7 @@ TEST_CASE("Barnes–Hut: the AVX-512 and the portable far-cell kernels agree", "
   FieldOptions o = bh_options(0.5);
   o.softening = 5e-4;
   o.bh_near_float = false;  // the near field in double: both paths must agree to ~1e-16
-  FieldWorkspace ws;
-  std::vector<Vec3> H1, H2;
-  std::vector<Mat3> J1, J2;
-  compute_fields(s, o, &H1, &J1, &ws);
-  detail::enable_simd_kernel(false);
-  compute_fields(s, o, &H2, &J2, &ws);
-  detail::enable_simd_kernel(true);
-  const Errors e = compare(H1, J1, H2, J2);
+  const Errors e = simd_vs_portable(s, o);
   INFO("SIMD vs portable: H max " << e.h_max << ", J max " << e.j_max);
   CHECK(e.h_max <= 1e-12);
   CHECK(e.j_max <= 1e-12);
@@ -543,14 +548,7 @@ TEST_CASE("Barnes–Hut float near field: AVX-512 and portable kernels agree to 
     const MomentSet s = layout == 0 ? magsim::test::fcc_pile(2000) : letters();
     FieldOptions o = bh_options(0.3);
     o.softening = layout == 1 ? 1e-3 : 0.0;
-    FieldWorkspace ws;
-    std::vector<Vec3> H1, H2;
-    std::vector<Mat3> J1, J2;
-    compute_fields(s, o, &H1, &J1, &ws);
-    detail::enable_simd_kernel(false);
-    compute_fields(s, o, &H2, &J2, &ws);
-    detail::enable_simd_kernel(true);
-    const Errors e = compare(H1, J1, H2, J2);
+    const Errors e = simd_vs_portable(s, o);
     INFO("layout " << layout << ": SIMD vs portable (float near): H rms " << e.h_rms << " max "
                    << e.h_max << "; J rms " << e.j_rms << " max " << e.j_max);
     CHECK(e.h_rms <= 2e-6);

@@ -1,33 +1,19 @@
 // Tests for tools/magsolve.cpp: the command line on good and bad input.
+#include "tests/tools/run_command.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <array>
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = magsim::test::CommandResult;
 
-Result run(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(MAGSOLVE_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = pclose(p);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
-  return r;
-}
+Result run(const std::string& args) { return magsim::test::run_command(MAGSOLVE_BIN, args); }
 
 std::string write_tmp(const std::string& name, const std::string& text) {
   const std::string path = "/tmp/magsolve_test_" + std::to_string(getpid()) + "_" + name;

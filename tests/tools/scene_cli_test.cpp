@@ -1,34 +1,20 @@
 // Tests for tools/magsim_scene.cpp: the ODE flags (--space, --quickstep-iterations,
 // --auto-disable) reach the run, and bad values are refused with a one-line error.
+#include "tests/tools/run_command.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <array>
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out;  // stdout and stderr together
-};
+using Result = magsim::test::CommandResult;
 
-Result run_scene(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(MAGSIM_SCENE_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = pclose(p);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
-  return r;
-}
+Result run_scene(const std::string& args) { return magsim::test::run_command(MAGSIM_SCENE_BIN, args); }
 
 std::string tmp_dir(const std::string& name) {
   return "/tmp/scene_cli_test_" + std::to_string(getpid()) + "_" + name;
