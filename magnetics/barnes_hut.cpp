@@ -29,7 +29,16 @@
 // (the double difference rounded: ~1e-9 m for sources a few cm away; absolute coordinates
 // never go to float), moments in float, ids and groups as int32 for the masks, padded to
 // 16 — and summed by sum_pairs_f32 (near_kernel_f32.cpp: 16 lanes, partial sums in float,
-// totals in double). The far cells stay in double.
+// totals in double). The sources' moments are converted to float once per call and their
+// ids and groups to int32 once per tree, so the gather converts positions only.
+//
+// Far cells in single precision (FieldOptions::bh_far_float, with the float near field):
+// a group's cells are gathered into CellBufferF — centres relative to g.tc, every field in
+// the group's length unit L (a power of two from the cells' distances, far_scale; chosen
+// with the lists, so the same for fresh and reused geometry) — and summed by far_sum_f32
+// (the same series in float, 16 lanes; partial sums in float per chunk, totals in double,
+// then × 1/(4π L³) or 1/(4π L⁴)). Otherwise (bh_far_float or bh_near_float false) the
+// far cells stay in double.
 //
 // Reuse: the magnetization solvers evaluate the fields 5–35 times per step at the same
 // positions with other moments. The tree, its centres and radii, the target groups and the
@@ -130,6 +139,44 @@ struct CellBuffer {
   }
 };
 
+// The same in float (FieldOptions::bh_far_float), blocks of 16 cells ([block][field][lane]),
+// as one group's kernel reads them: every field scaled to the group's length unit L (a power
+// of two, GroupLists::far_inv_scale = 1/L; see far_scale): the centre relative to the group's
+// centre g.tc, c' = (c − g.tc)/L (the double difference, scaled exactly, then rounded —
+// absolute world coordinates never go to float), M' = M, S' = S/L, tr S' = tr S/L,
+// O' = O/L², t' = t/L². Then the series in r' = r/L gives L³ · 4π h and L⁴ · 4π J exactly as
+// the series in r does (each term is homogeneous), and with |r'| ≥ ½ (see far_scale) no
+// power of 1/|r'| up to the 11th can overflow. Lanes past `n` hold zeros; the kernels mask
+// them (1/|r'| := 0), so no padding position is needed.
+struct CellBufferF {
+  static constexpr std::size_t kBlock = 16 * kCellFields;
+  std::vector<float> d;  // storage (grown, never shrunk)
+  std::size_t n = 0;     // cells held
+  std::size_t size() const { return n; }
+  std::size_t blocks() const { return (n + 15) / 16; }
+  const float* block(std::size_t b) const { return d.data() + b * kBlock; }
+  void clear() { n = 0; }
+  // cell fields f (double, absolute centre) → scaled float relative to the centre tc
+  void push(const double* f, const double* tc, double inv) {
+    if ((n / 16 + 1) * kBlock > d.size()) d.resize(std::max<std::size_t>(4 * kBlock, 2 * d.size()));
+    float* blk = d.data() + (n / 16) * kBlock + n % 16;
+    const double inv2 = inv * inv;
+    static_assert(kCx == 0 && kMx == 3 && kSxx == 6 && kOxxx == 13 && kTz + 1 == kCellFields);
+    for (int k = kCx; k <= kCz; ++k) blk[16 * k] = static_cast<float>((f[k] - tc[k]) * inv);
+    for (int k = kMx; k <= kMz; ++k) blk[16 * k] = static_cast<float>(f[k]);
+    for (int k = kSxx; k <= kTrS; ++k) blk[16 * k] = static_cast<float>(f[k] * inv);
+    for (int k = kOxxx; k < kCellFields; ++k) blk[16 * k] = static_cast<float>(f[k] * inv2);  // O, t
+    ++n;
+  }
+  // zeros in the rest of the last block (masked by the kernels)
+  void pad() {
+    if (n % 16 == 0) return;
+    float* blk = d.data() + (n / 16) * kBlock;
+    for (int k = 0; k < kCellFields; ++k)
+      for (std::size_t l = n % 16; l < 16; ++l) blk[16 * k + l] = 0.0f;
+  }
+};
+
 // Near sources gathered for one group: whole leaves copied from the tree-ordered arrays.
 struct NearBuffer {
   std::vector<double> a[8];  // x, y, z, mx, my, mz, id, grp (grown, never shrunk)
@@ -175,18 +222,25 @@ struct NearBufferF {
     id.resize(sz);
     grp.resize(sz);
   }
-  void append(const detail::SourceBuffer& s, int s0, int s1, const double* c) {
-    reserve(n + (s1 - s0) + detail::kSourcePadF);
-    for (int k = s0; k < s1; ++k, ++n) {
-      a[0][n] = static_cast<float>(s.x[k] - c[0]);
-      a[1][n] = static_cast<float>(s.y[k] - c[1]);
-      a[2][n] = static_cast<float>(s.z[k] - c[2]);
-      a[3][n] = static_cast<float>(s.mx[k]);
-      a[4][n] = static_cast<float>(s.my[k]);
-      a[5][n] = static_cast<float>(s.mz[k]);
-      id[n] = static_cast<std::int32_t>(s.id[k]);
-      grp[n] = static_cast<std::int32_t>(s.grp[k]);  // −1: none
+  // sources s0..s1 of s; their moments, ids and groups already in float / int32 (mf, id32,
+  // grp32: the workspace's copies, converted once per call / per tree)
+  void append(const detail::SourceBuffer& s, const std::vector<float>* mf,
+              const std::vector<std::int32_t>& id32, const std::vector<std::int32_t>& grp32,
+              int s0, int s1, const double* c) {
+    const std::size_t m = static_cast<std::size_t>(s1 - s0);
+    reserve(n + m + detail::kSourcePadF);
+    const double* src[3] = {s.x.data() + s0, s.y.data() + s0, s.z.data() + s0};
+    for (int a3 = 0; a3 < 3; ++a3) {  // separate loops: vectorized (vcvtpd2ps)
+      const double* __restrict in = src[a3];
+      float* __restrict out = a[a3].data() + n;
+      const double ca = c[a3];
+      for (std::size_t k = 0; k < m; ++k) out[k] = static_cast<float>(in[k] - ca);
     }
+    for (int a3 = 0; a3 < 3; ++a3)
+      std::memcpy(a[3 + a3].data() + n, mf[a3].data() + s0, m * sizeof(float));
+    std::memcpy(id.data() + n, id32.data() + s0, m * sizeof(std::int32_t));
+    std::memcpy(grp.data() + n, grp32.data() + s0, m * sizeof(std::int32_t));  // −1: none
+    n += m;
   }
   void pad() {
     reserve(n + detail::kSourcePadF);
@@ -207,12 +261,14 @@ struct NearBufferF {
 // Jacobian only) and near leaves (exact: field and Jacobian / Jacobian only).
 struct GroupLists {
   std::vector<int> far_hj, far_h, far_j, near, near_j;
+  double far_inv_scale = 1.0;  // 1/L of the float far cells (a power of two; far_scale)
 };
 
 struct ThreadScratch {
   NearBuffer near, near_j;                  // exact sources: H and J / J only
   NearBufferF nearf, nearf_j;               // the same in float (bh_near_float)
   CellBuffer far_hj, far_h, far_j;          // cells: field and Jacobian / field only / J only
+  CellBufferF far_hjf, far_hf, far_jf;      // the same in float, scaled (bh_far_float)
   std::vector<std::pair<int, bool>> stack;  // (node, J-only)
   long near_pairs = 0, far_cells = 0;       // interaction counts (statistics)
   double lists_s = 0;                       // time spent building lists (statistics)
@@ -245,6 +301,8 @@ struct BarnesHutWorkspace {
   std::vector<Group> groups;
   detail::SourceBuffer src;  // nonzero sources in tree order (not padded)
   std::vector<double> src_w;  // their largest possible |m_i|
+  std::vector<std::int32_t> src_id32, src_grp32;  // their ids and groups (−1: none) as int32
+  std::vector<float> src_mf[3];                   // their moments in float (this call)
   std::vector<ThreadScratch> threads;
   BarnesHutStats stats;
 };
@@ -537,6 +595,13 @@ void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspac
     ws->src_w.push_back(ws->w[i]);
   }
   ws->src_prefix[n] = static_cast<int>(ws->src.size());
+  const std::size_t ns = ws->src.size();
+  ws->src_id32.resize(ns);
+  ws->src_grp32.resize(ns);
+  for (std::size_t k = 0; k < ns; ++k) {
+    ws->src_id32[k] = static_cast<std::int32_t>(ws->src.id[k]);
+    ws->src_grp32[k] = static_cast<std::int32_t>(ws->src.grp[k]);
+  }
 
   ws->nodes.assign(1, Node{});
   ws->nodes[0].t1 = n;
@@ -567,6 +632,12 @@ void update_multipoles(const MomentSet& set, BarnesHutWorkspace* ws) {
     const Vec3 m = set.moment(static_cast<std::size_t>(s.id[k]));
     s.mx[k] = m.x(); s.my[k] = m.y(); s.mz[k] = m.z();
   }
+  // float copies for the float near field's gather (cheap; done whatever the options)
+  const std::vector<double>* md[3] = {&s.mx, &s.my, &s.mz};
+  for (int a = 0; a < 3; ++a) {
+    ws->src_mf[a].resize(ns);
+    for (int k = 0; k < ns; ++k) ws->src_mf[a][k] = static_cast<float>((*md[a])[k]);
+  }
   const int nn = static_cast<int>(ws->nodes.size());
   for (int id = nn - 1; id >= 0; --id) node_multipole(s, ws, id);
   ws->cells.resize(static_cast<std::size_t>(nn) * kCellFields);
@@ -579,6 +650,37 @@ void update_multipoles(const MomentSet& set, BarnesHutWorkspace* ws) {
 bool groups_overlap(const NodeHot& src, const Group& g) {
   return src.gmax >= 0 && g.tgmax >= 0 && src.gmin <= g.tgmax && g.tgmin <= src.gmax &&
          (src.gmask & g.tgmask) != 0;
+}
+
+// The length unit L of a group's float far cells (CellBufferF), returned as 1/L, a power of
+// two (so the scaling is exact). Every target sees every listed cell's centre at
+// |r| ≥ d_min = min R − b_t (R: centre to the group's centre; > 0 by the acceptance test)
+// and at |r| ≤ d_max = max R + b_t. L = d_min rounded up to a power of two (so |r'| ≥ ½,
+// and 1/|r'|¹¹ ≤ 2¹¹: no overflow), raised towards d_max / 1024 when the cells span more
+// than three decades (so that |r'| ≤ ~1024 and 1/|r'|¹¹ ≥ 2⁻¹¹⁰ stays a normal float), but
+// never above 256 d_min (then 1/|r'|¹¹ ≤ 2⁹⁹). Beyond those spans (d_max/d_min > 2.6e5) the
+// highest powers of the farthest cells underflow towards 0 (their terms are negligible
+// there); nothing overflows. Depends on the lists and the tree only: the same for fresh
+// and reused geometry, whatever the thread.
+double far_scale(const BarnesHutWorkspace& ws, const Group& g, const GroupLists& gl) {
+  double r2min = std::numeric_limits<double>::infinity(), r2max = 0;
+  for (const std::vector<int>* ids : {&gl.far_hj, &gl.far_h, &gl.far_j})
+    for (int id : *ids) {
+      const NodeHot& nd = ws.hot[id];
+      const double dx = nd.c[0] - g.tc[0], dy = nd.c[1] - g.tc[1], dz = nd.c[2] - g.tc[2];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      r2min = std::min(r2min, r2);
+      r2max = std::max(r2max, r2);
+    }
+  if (!(r2max > 0)) return 1.0;
+  const double dmax = std::sqrt(r2max) + g.tb;
+  double dmin = std::sqrt(r2min) - g.tb;
+  if (!(dmin > 0)) dmin = dmax * 1e-6;  // (not reached: accepted cells lie outside the sphere)
+  const double L = std::min(std::max(dmin, dmax / 1024.0), 256.0 * dmin);
+  if (!(L > 0) || !std::isfinite(L)) return 1.0;
+  int e = 0;
+  std::frexp(L, &e);  // L = f 2^e, f ∈ [½, 1): 2^e ≥ L
+  return std::ldexp(1.0, -e);
 }
 
 // Walks the tree for one target group and fills its interaction lists (see file comment).
@@ -622,14 +724,17 @@ void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, boo
     const bool child_j_only = j_only || accept;
     for (int c = nd.child + nd.nchild - 1; c >= nd.child; --c) stack->emplace_back(c, child_j_only);
   }
+  gl->far_inv_scale = far_scale(ws, g, *gl);
 }
 
 // Copies a group's listed cells and near sources (with this call's moments) into the
 // thread's kernel buffers, padded.
 // With near_float the near sources go to the float buffers instead, relative to the group's
 // centre g.tc.
+// With far_float the far cells go to the float buffers, relative to g.tc and scaled by
+// gl.far_inv_scale (CellBufferF).
 void gather(const BarnesHutWorkspace& ws, const Group& g, const GroupLists& gl, bool near_float,
-            ThreadScratch* th) {
+            bool far_float, ThreadScratch* th) {
   th->near.clear();
   th->near_j.clear();
   th->nearf.clear();
@@ -637,19 +742,33 @@ void gather(const BarnesHutWorkspace& ws, const Group& g, const GroupLists& gl, 
   th->far_hj.clear();
   th->far_h.clear();
   th->far_j.clear();
+  th->far_hjf.clear();
+  th->far_hf.clear();
+  th->far_jf.clear();
   auto cells = [&ws](const std::vector<int>& ids, CellBuffer* cb) {
     for (int id : ids) cb->push(&ws.cells[std::size_t(id) * kCellFields]);
     cb->pad();
   };
-  cells(gl.far_hj, &th->far_hj);
-  cells(gl.far_h, &th->far_h);
-  cells(gl.far_j, &th->far_j);
+  auto cells_f = [&ws, &g, &gl](const std::vector<int>& ids, CellBufferF* cb) {
+    for (int id : ids) cb->push(&ws.cells[std::size_t(id) * kCellFields], g.tc, gl.far_inv_scale);
+    cb->pad();
+  };
+  if (far_float) {
+    cells_f(gl.far_hj, &th->far_hjf);
+    cells_f(gl.far_h, &th->far_hf);
+    cells_f(gl.far_j, &th->far_jf);
+  } else {
+    cells(gl.far_hj, &th->far_hj);
+    cells(gl.far_h, &th->far_h);
+    cells(gl.far_j, &th->far_j);
+  }
   auto leaves = [&ws](const std::vector<int>& ids, NearBuffer* nb) {
     for (int id : ids) nb->append(ws.src, ws.hot[id].s0, ws.hot[id].s1);
     nb->pad();
   };
   auto leaves_f = [&ws, &g](const std::vector<int>& ids, NearBufferF* nb) {
-    for (int id : ids) nb->append(ws.src, ws.hot[id].s0, ws.hot[id].s1, g.tc);
+    for (int id : ids)
+      nb->append(ws.src, ws.src_mf, ws.src_id32, ws.src_grp32, ws.hot[id].s0, ws.hot[id].s1, g.tc);
     nb->pad();
   };
   if (near_float) {
@@ -907,6 +1026,293 @@ void far_sum(const CellBuffer& cb, int order, const double* p, double eps2, doub
   else far_portable<kH, kJ, 1>(cb, p, eps2, H, J);
 }
 
+// ---- far-cell kernel in single precision (FieldOptions::bh_far_float) ---------------------
+//
+// The same series as far_portable / far_avx512, in float, on a group's scaled cells
+// (CellBufferF: r' = r/L, S' = S/L, O' = O/L², so the sums below are L³ · 4π h and L⁴ · 4π J;
+// sH = 1/(4π L³) and sJ = 1/(4π L⁴) undo both in double). 1/√q: vrsqrt14ps refined by one
+// Newton–Raphson step (≈ 1.5·2⁻²⁸, below float rounding) on AVX-512, 1/std::sqrt in the
+// portable loop; lanes past the last cell masked to 1/√q = 0 (their cells are zeros, so every
+// term is exactly 0). Partial sums in float over at most kFarChunkF cells (kFarChunkF / 16
+// per lane), then in double, in a fixed order: deterministic, and the float rounding of the
+// sum does not grow with the list. The two kernels agree to float rounding (not bitwise).
+
+// Cells per chunk of float partial sums (64 per AVX-512 lane; lists are rarely longer).
+constexpr std::size_t kFarChunkF = 1024;
+
+template <bool kH, bool kJ, int kOrder>
+void far_f32_portable(const CellBufferF& cb, const float* p, float eps2, double sH, double sJ,
+                      double* Hout, double* Jout) {
+  double acc[10] = {};  // hx hy hz ja jxx jyy jzz jxy jxz jyz
+  const std::size_t nb = cb.blocks();
+  // float partial sums of kFarChunkF / 16 cells (as many as an AVX-512 lane sums)
+  constexpr std::size_t kChunkBlocks = kFarChunkF / 16 / 16;
+  for (std::size_t b0 = 0; b0 < nb; b0 += kChunkBlocks) {
+    const std::size_t b1 = std::min(nb, b0 + kChunkBlocks);
+    float hx = 0, hy = 0, hz = 0;
+    float ja = 0, jxx = 0, jyy = 0, jzz = 0, jxy = 0, jxz = 0, jyz = 0;
+    for (std::size_t blk = b0; blk < b1; ++blk) {
+    const float* B = cb.block(blk);
+    const std::size_t valid = std::min<std::size_t>(16, cb.size() - 16 * blk);
+    const float *cx = B + 16 * kCx, *cy = B + 16 * kCy, *cz = B + 16 * kCz, *Mx = B + 16 * kMx,
+                *My = B + 16 * kMy, *Mz = B + 16 * kMz, *Sxx = B + 16 * kSxx, *Syy = B + 16 * kSyy,
+                *Szz = B + 16 * kSzz, *Sxy = B + 16 * kSxy, *Sxz = B + 16 * kSxz,
+                *Syz = B + 16 * kSyz, *trS = B + 16 * kTrS, *Oxxx = B + 16 * kOxxx,
+                *Oyyy = B + 16 * kOyyy, *Ozzz = B + 16 * kOzzz, *Oxxy = B + 16 * kOxxy,
+                *Oxxz = B + 16 * kOxxz, *Oxyy = B + 16 * kOxyy, *Oyyz = B + 16 * kOyyz,
+                *Oxzz = B + 16 * kOxzz, *Oyzz = B + 16 * kOyzz, *Oxyz = B + 16 * kOxyz,
+                *Tx = B + 16 * kTx, *Ty = B + 16 * kTy, *Tz = B + 16 * kTz;
+#pragma omp simd reduction(+ : hx, hy, hz, ja, jxx, jyy, jzz, jxy, jxz, jyz)
+    for (std::size_t i = 0; i < 16; ++i) {
+      const float rx = p[0] - cx[i], ry = p[1] - cy[i], rz = p[2] - cz[i];
+      const float q = rx * rx + ry * ry + rz * rz + eps2;
+      const float u = i < valid ? 1.0f / std::sqrt(i < valid ? q : 1.0f) : 0.0f;  // padding: 0
+      const float u2 = u * u, u3 = u2 * u, u5 = u3 * u2, u7 = u5 * u2, u9 = u7 * u2,
+                  u11 = u9 * u2;
+      const float wx = Sxx[i] * rx + Sxy[i] * ry + Sxz[i] * rz;
+      const float wy = Sxy[i] * rx + Syy[i] * ry + Syz[i] * rz;
+      const float wz = Sxz[i] * rx + Syz[i] * ry + Szz[i] * rz;
+      const float s = rx * wx + ry * wy + rz * wz;
+      const float rho = rx * Mx[i] + ry * My[i] + rz * Mz[i] - trS[i];
+      float oxx = 0, oyy = 0, ozz = 0, oxy = 0, oxz = 0, oyz = 0;  // o1
+      float o2x = 0, o2y = 0, o2z = 0, o3 = 0, tau = 0, tx = 0, ty = 0, tz = 0;
+      if constexpr (kOrder >= 2) {
+        oxx = Oxxx[i] * rx + Oxxy[i] * ry + Oxxz[i] * rz;
+        oyy = Oxyy[i] * rx + Oyyy[i] * ry + Oyyz[i] * rz;
+        ozz = Oxzz[i] * rx + Oyzz[i] * ry + Ozzz[i] * rz;
+        oxy = Oxxy[i] * rx + Oxyy[i] * ry + Oxyz[i] * rz;
+        oxz = Oxxz[i] * rx + Oxyz[i] * ry + Oxzz[i] * rz;
+        oyz = Oxyz[i] * rx + Oyyz[i] * ry + Oyzz[i] * rz;
+        o2x = oxx * rx + oxy * ry + oxz * rz;
+        o2y = oxy * rx + oyy * ry + oyz * rz;
+        o2z = oxz * rx + oyz * ry + ozz * rz;
+        o3 = o2x * rx + o2y * ry + o2z * rz;
+        tx = Tx[i]; ty = Ty[i]; tz = Tz[i];
+        tau = tx * rx + ty * ry + tz * rz;
+      }
+      // A = 3ρ u5 + (15 s − 22.5 τ) u7 + 52.5 o3 u9
+      const float A = 3.0f * rho * u5 + (15.0f * s - 22.5f * tau) * u7 + 52.5f * o3 * u9;
+      if constexpr (kH) {
+        // 4π h = A r − u3 M + u5 (4.5 t − 6 w) − 22.5 u7 o2
+        hx += A * rx - u3 * Mx[i] + u5 * (4.5f * tx - 6.0f * wx) - 22.5f * u7 * o2x;
+        hy += A * ry - u3 * My[i] + u5 * (4.5f * ty - 6.0f * wy) - 22.5f * u7 * o2y;
+        hz += A * rz - u3 * Mz[i] + u5 * (4.5f * tz - 6.0f * wz) - 22.5f * u7 * o2z;
+      }
+      if constexpr (kJ) {
+        // c_r = −7.5 ρ u7 + (78.75 τ − 52.5 s) u9 − 236.25 o3 u11
+        // K = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
+        // 4π J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1
+        const float cr = -7.5f * rho * u7 + (78.75f * tau - 52.5f * s) * u9 - 236.25f * o3 * u11;
+        const float Kx = 3.0f * u5 * Mx[i] + u7 * (30.0f * wx - 22.5f * tx) + 157.5f * u9 * o2x + cr * rx;
+        const float Ky = 3.0f * u5 * My[i] + u7 * (30.0f * wy - 22.5f * ty) + 157.5f * u9 * o2y + cr * ry;
+        const float Kz = 3.0f * u5 * Mz[i] + u7 * (30.0f * wz - 22.5f * tz) + 157.5f * u9 * o2z + cr * rz;
+        ja += A;
+        jxx += 2.0f * rx * Kx - 6.0f * u5 * Sxx[i] - 45.0f * u7 * oxx;
+        jyy += 2.0f * ry * Ky - 6.0f * u5 * Syy[i] - 45.0f * u7 * oyy;
+        jzz += 2.0f * rz * Kz - 6.0f * u5 * Szz[i] - 45.0f * u7 * ozz;
+        jxy += rx * Ky + ry * Kx - 6.0f * u5 * Sxy[i] - 45.0f * u7 * oxy;
+        jxz += rx * Kz + rz * Kx - 6.0f * u5 * Sxz[i] - 45.0f * u7 * oxz;
+        jyz += ry * Kz + rz * Ky - 6.0f * u5 * Syz[i] - 45.0f * u7 * oyz;
+      }
+    }
+    }
+    const float part[10] = {hx, hy, hz, ja, jxx, jyy, jzz, jxy, jxz, jyz};
+    for (int k = 0; k < 10; ++k) acc[k] += part[k];
+  }
+  if constexpr (kH) {
+    Hout[0] += acc[0] * sH; Hout[1] += acc[1] * sH; Hout[2] += acc[2] * sH;
+  }
+  if constexpr (kJ) {
+    Jout[0] += (acc[3] + acc[4]) * sJ; Jout[1] += (acc[3] + acc[5]) * sJ;
+    Jout[2] += (acc[3] + acc[6]) * sJ;
+    Jout[3] += acc[7] * sJ; Jout[4] += acc[8] * sJ; Jout[5] += acc[9] * sJ;
+  }
+}
+
+#ifdef MAGSIM_AVX512_KERNEL
+
+using V16 = __m512;
+MAGSIM_TARGET_AVX512 inline V16 fset1(float x) { return _mm512_set1_ps(x); }
+MAGSIM_TARGET_AVX512 inline V16 fld(const float* p) { return _mm512_loadu_ps(p); }
+MAGSIM_TARGET_AVX512 inline V16 add(V16 a, V16 b) { return _mm512_add_ps(a, b); }
+MAGSIM_TARGET_AVX512 inline V16 sub(V16 a, V16 b) { return _mm512_sub_ps(a, b); }
+MAGSIM_TARGET_AVX512 inline V16 mul(V16 a, V16 b) { return _mm512_mul_ps(a, b); }
+MAGSIM_TARGET_AVX512 inline V16 fma(V16 a, V16 b, V16 c) { return _mm512_fmadd_ps(a, b, c); }
+MAGSIM_TARGET_AVX512 inline V16 fnma(V16 a, V16 b, V16 c) { return _mm512_fnmadd_ps(a, b, c); }
+// a·x + b·y + c·z
+MAGSIM_TARGET_AVX512 inline V16 dot3(V16 a, V16 b, V16 c, V16 x, V16 y, V16 z) {
+  return fma(c, z, fma(b, y, mul(a, x)));
+}
+
+// 1/√q in the lanes of `keep` (0 elsewhere): vrsqrt14ps (|rel. error| ≤ 2⁻¹⁴) and one
+// Newton–Raphson step y + (y/2)(1 − q y²) (≈ 1.5·2⁻²⁸), as in near_kernel_f32.cpp
+MAGSIM_TARGET_AVX512 inline V16 rsqrt_ps(__mmask16 keep, V16 q) {
+  const V16 y = _mm512_maskz_rsqrt14_ps(keep, q);
+  const V16 e = fnma(q, mul(y, y), fset1(1.0f));
+  return fma(mul(y, fset1(0.5f)), e, y);
+}
+
+// The 16 float lanes of v widened and added to the 8 double lanes of acc (lane k gets float
+// lanes k and k + 8): exact widening, a fixed order (as in near_kernel_f32.cpp).
+MAGSIM_TARGET_AVX512 inline V8 widen_add(V8 acc, V16 v) {
+  const __m512d vd = _mm512_castps_pd(v);
+  const __m256 l = _mm256_castpd_ps(_mm512_maskz_extractf64x4_pd(0xf, vd, 0));
+  const __m256 h = _mm256_castpd_ps(_mm512_maskz_extractf64x4_pd(0xf, vd, 1));
+  return add(acc, add(_mm512_maskz_cvtps_pd(0xff, l), _mm512_maskz_cvtps_pd(0xff, h)));
+}
+
+template <bool kH, bool kJ, int kOrder>
+MAGSIM_TARGET_AVX512 void far_f32_avx512(const CellBufferF& cb, const float* p, float eps2,
+                                         double sH, double sJ, double* Hout, double* Jout) {
+  const V16 px = fset1(p[0]), py = fset1(p[1]), pz = fset1(p[2]), e2 = fset1(eps2);
+  const V16 zero = _mm512_setzero_ps();
+  // double accumulators across chunks: hx hy hz ja jxx jyy jzz jxy jxz jyz
+  V8 acc[10];
+  for (V8& a : acc) a = _mm512_setzero_pd();
+  const std::size_t nb = cb.blocks();
+  constexpr std::size_t kChunkBlocks = kFarChunkF / 16;
+  for (std::size_t b0 = 0; b0 < nb; b0 += kChunkBlocks) {
+    const std::size_t b1 = std::min(nb, b0 + kChunkBlocks);
+    V16 hx = zero, hy = zero, hz = zero;
+    V16 ja = zero, jxx = zero, jyy = zero, jzz = zero, jxy = zero, jxz = zero, jyz = zero;
+    for (std::size_t blk = b0; blk < b1; ++blk) {
+    const float* B = cb.block(blk);
+    const std::size_t valid = std::min<std::size_t>(16, cb.size() - 16 * blk);
+    const __mmask16 keep = static_cast<__mmask16>((1u << valid) - 1u);
+    const V16 rx = sub(px, fld(B + 16 * kCx)), ry = sub(py, fld(B + 16 * kCy)), rz = sub(pz, fld(B + 16 * kCz));
+    const V16 q = fma(rz, rz, fma(ry, ry, fma(rx, rx, e2)));
+    const V16 u = rsqrt_ps(keep, q);
+    const V16 u2 = mul(u, u), u3 = mul(u2, u), u5 = mul(u3, u2), u7 = mul(u5, u2);
+    const V16 Sxx = fld(B + 16 * kSxx), Syy = fld(B + 16 * kSyy), Szz = fld(B + 16 * kSzz),
+              Sxy = fld(B + 16 * kSxy), Sxz = fld(B + 16 * kSxz), Syz = fld(B + 16 * kSyz);
+    const V16 Mx = fld(B + 16 * kMx), My = fld(B + 16 * kMy), Mz = fld(B + 16 * kMz);
+    const V16 wx = dot3(Sxx, Sxy, Sxz, rx, ry, rz);
+    const V16 wy = dot3(Sxy, Syy, Syz, rx, ry, rz);
+    const V16 wz = dot3(Sxz, Syz, Szz, rx, ry, rz);
+    const V16 s = dot3(rx, ry, rz, wx, wy, wz);
+    const V16 rho = sub(dot3(rx, ry, rz, Mx, My, Mz), fld(B + 16 * kTrS));
+    V16 oxx = zero, oyy = zero, ozz = zero, oxy = zero, oxz = zero, oyz = zero;
+    V16 o2x = zero, o2y = zero, o2z = zero, o3 = zero, tau = zero, tx = zero, ty = zero,
+        tz = zero, u9 = zero;
+    // A = 3ρ u5 + (15 s − 22.5 τ) u7 + 52.5 o3 u9
+    V16 A = fma(mul(fset1(3.0f), rho), u5, mul(mul(fset1(15.0f), s), u7));
+    if constexpr (kOrder >= 2) {
+      const V16 Oxxy = fld(B + 16 * kOxxy), Oxxz = fld(B + 16 * kOxxz), Oxyy = fld(B + 16 * kOxyy),
+                Oyyz = fld(B + 16 * kOyyz), Oxzz = fld(B + 16 * kOxzz), Oyzz = fld(B + 16 * kOyzz),
+                Oxyz = fld(B + 16 * kOxyz);
+      oxx = dot3(fld(B + 16 * kOxxx), Oxxy, Oxxz, rx, ry, rz);
+      oyy = dot3(Oxyy, fld(B + 16 * kOyyy), Oyyz, rx, ry, rz);
+      ozz = dot3(Oxzz, Oyzz, fld(B + 16 * kOzzz), rx, ry, rz);
+      oxy = dot3(Oxxy, Oxyy, Oxyz, rx, ry, rz);
+      oxz = dot3(Oxxz, Oxyz, Oxzz, rx, ry, rz);
+      oyz = dot3(Oxyz, Oyyz, Oyzz, rx, ry, rz);
+      o2x = dot3(oxx, oxy, oxz, rx, ry, rz);
+      o2y = dot3(oxy, oyy, oyz, rx, ry, rz);
+      o2z = dot3(oxz, oyz, ozz, rx, ry, rz);
+      o3 = dot3(o2x, o2y, o2z, rx, ry, rz);
+      tx = fld(B + 16 * kTx); ty = fld(B + 16 * kTy); tz = fld(B + 16 * kTz);
+      tau = dot3(tx, ty, tz, rx, ry, rz);
+      u9 = mul(u7, u2);
+      A = fma(mul(fset1(52.5f), o3), u9, fnma(mul(fset1(22.5f), tau), u7, A));
+    }
+    if constexpr (kH) {
+      // 4π h = A r − u3 M − u5 v − 22.5 u7 o2,  v = 6 w − 4.5 t
+      const V16 c6 = fset1(6.0f);
+      V16 vx = mul(c6, wx), vy = mul(c6, wy), vz = mul(c6, wz);
+      if constexpr (kOrder >= 2) {
+        const V16 c45 = fset1(4.5f), u7_225 = mul(fset1(22.5f), u7);
+        vx = fnma(c45, tx, vx);
+        vy = fnma(c45, ty, vy);
+        vz = fnma(c45, tz, vz);
+        hx = fnma(u7_225, o2x, hx);
+        hy = fnma(u7_225, o2y, hy);
+        hz = fnma(u7_225, o2z, hz);
+      }
+      hx = fnma(u3, Mx, fnma(u5, vx, fma(A, rx, hx)));
+      hy = fnma(u3, My, fnma(u5, vy, fma(A, ry, hy)));
+      hz = fnma(u3, Mz, fnma(u5, vz, fma(A, rz, hz)));
+    }
+    if constexpr (kJ) {
+      // c_r = −7.5 ρ u7 + (78.75 τ − 52.5 s) u9 − 236.25 o3 u11
+      // K = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
+      if constexpr (kOrder < 2) u9 = mul(u7, u2);
+      V16 cr = fnma(mul(fset1(7.5f), rho), u7, mul(mul(fset1(-52.5f), s), u9));
+      const V16 u5_3m = mul(fset1(3.0f), u5), u7_30 = mul(fset1(30.0f), u7);
+      V16 Kx = fma(u7_30, wx, mul(u5_3m, Mx));
+      V16 Ky = fma(u7_30, wy, mul(u5_3m, My));
+      V16 Kz = fma(u7_30, wz, mul(u5_3m, Mz));
+      if constexpr (kOrder >= 2) {
+        const V16 u11 = mul(u9, u2);
+        cr = fnma(mul(fset1(236.25f), o3), u11, fma(mul(fset1(78.75f), tau), u9, cr));
+        const V16 u7_225 = mul(fset1(22.5f), u7), u9_1575 = mul(fset1(157.5f), u9);
+        Kx = fma(u9_1575, o2x, fnma(u7_225, tx, Kx));
+        Ky = fma(u9_1575, o2y, fnma(u7_225, ty, Ky));
+        Kz = fma(u9_1575, o2z, fnma(u7_225, tz, Kz));
+      }
+      Kx = fma(cr, rx, Kx);
+      Ky = fma(cr, ry, Ky);
+      Kz = fma(cr, rz, Kz);
+      // 4π J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1; the diagonal sums hold half of their
+      // r K, S and o1 terms (doubled at the end)
+      const V16 u5_3 = mul(fset1(3.0f), u5), u5_6 = mul(fset1(6.0f), u5);
+      ja = add(ja, A);
+      V16 dxx = fnma(u5_3, Sxx, mul(rx, Kx)), dyy = fnma(u5_3, Syy, mul(ry, Ky)),
+          dzz = fnma(u5_3, Szz, mul(rz, Kz));
+      V16 dxy = fnma(u5_6, Sxy, fma(ry, Kx, mul(rx, Ky)));
+      V16 dxz = fnma(u5_6, Sxz, fma(rz, Kx, mul(rx, Kz)));
+      V16 dyz = fnma(u5_6, Syz, fma(rz, Ky, mul(ry, Kz)));
+      if constexpr (kOrder >= 2) {
+        const V16 u7_225 = mul(fset1(22.5f), u7), u7_45 = mul(fset1(45.0f), u7);
+        dxx = fnma(u7_225, oxx, dxx);
+        dyy = fnma(u7_225, oyy, dyy);
+        dzz = fnma(u7_225, ozz, dzz);
+        dxy = fnma(u7_45, oxy, dxy);
+        dxz = fnma(u7_45, oxz, dxz);
+        dyz = fnma(u7_45, oyz, dyz);
+      }
+      jxx = add(jxx, dxx); jyy = add(jyy, dyy); jzz = add(jzz, dzz);
+      jxy = add(jxy, dxy); jxz = add(jxz, dxz); jyz = add(jyz, dyz);
+    }
+    }
+    if constexpr (kH) {
+      acc[0] = widen_add(acc[0], hx); acc[1] = widen_add(acc[1], hy); acc[2] = widen_add(acc[2], hz);
+    }
+    if constexpr (kJ) {
+      acc[3] = widen_add(acc[3], ja); acc[4] = widen_add(acc[4], jxx);
+      acc[5] = widen_add(acc[5], jyy); acc[6] = widen_add(acc[6], jzz);
+      acc[7] = widen_add(acc[7], jxy); acc[8] = widen_add(acc[8], jxz);
+      acc[9] = widen_add(acc[9], jyz);
+    }
+  }
+  if constexpr (kH) {
+    Hout[0] += hsum(acc[0]) * sH; Hout[1] += hsum(acc[1]) * sH; Hout[2] += hsum(acc[2]) * sH;
+  }
+  if constexpr (kJ) {
+    const double a = hsum(acc[3]);
+    Jout[0] += (a + 2.0 * hsum(acc[4])) * sJ; Jout[1] += (a + 2.0 * hsum(acc[5])) * sJ;
+    Jout[2] += (a + 2.0 * hsum(acc[6])) * sJ;
+    Jout[3] += hsum(acc[7]) * sJ; Jout[4] += hsum(acc[8]) * sJ; Jout[5] += hsum(acc[9]) * sJ;
+  }
+}
+
+#endif  // MAGSIM_AVX512_KERNEL
+
+// Adds a group's float far cells at the scaled target p' (sH = 1/(4π L³), sJ = 1/(4π L⁴)).
+template <bool kH, bool kJ>
+void far_sum_f32(const CellBufferF& cb, int order, const float* p, float eps2, double sH,
+                 double sJ, double* H, double* J) {
+  if (cb.size() == 0) return;
+#ifdef MAGSIM_AVX512_KERNEL
+  if (detail::simd_kernel_active()) {
+    if (order >= 2) far_f32_avx512<kH, kJ, 2>(cb, p, eps2, sH, sJ, H, J);
+    else far_f32_avx512<kH, kJ, 1>(cb, p, eps2, sH, sJ, H, J);
+    return;
+  }
+#endif
+  if (order >= 2) far_f32_portable<kH, kJ, 2>(cb, p, eps2, sH, sJ, H, J);
+  else far_f32_portable<kH, kJ, 1>(cb, p, eps2, sH, sJ, H, J);
+}
+
 }  // namespace
 
 void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
@@ -951,6 +1357,9 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   const float eps2f = static_cast<float>(eps2);
   // θ = 0 promises the direct sum: the near field (then everything) stays in double
   const bool near_float = opt.bh_near_float && opt.bh_theta > 0;
+  // the far cells in float too (only with the near field in float: bh_near_float = false
+  // keeps the whole sum in double)
+  const bool far_float = near_float && opt.bh_far_float;
   const bool want_J = J != nullptr;
   const int mode = want_J ? 1 : 0;
   const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.bh_theta;
@@ -973,12 +1382,18 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
       const auto t_l0 = std::chrono::steady_clock::now();
       if (new_lists) build_lists(*ws, g, opt.bh_theta, want_J, &th.stack, &lists[l]);
       th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
-      gather(*ws, g, lists[l], near_float, &th);
+      gather(*ws, g, lists[l], near_float, far_float, &th);
       const detail::SourceView vn = th.near.view(), vj = th.near_j.view();
       const detail::SourceViewF vnf = th.nearf.view(), vjf = th.nearf_j.view();
       const long nt = g.t1 - g.t0;
       th.near_pairs += nt * static_cast<long>(vn.n + vj.n + vnf.n + vjf.n);
-      th.far_cells += nt * static_cast<long>(th.far_hj.size() + th.far_h.size() + th.far_j.size());
+      th.far_cells += nt * static_cast<long>(th.far_hj.size() + th.far_h.size() + th.far_j.size() +
+                                             16 * (th.far_hjf.blocks() + th.far_hf.blocks() +
+                                                   th.far_jf.blocks()));
+      // float far cells: unit L = 1/inv (exact powers of two), 4π and L³ (L⁴) undone in double
+      const double inv = lists[l].far_inv_scale;
+      const double sH = kInv4Pi * inv * inv * inv, sJ = sH * inv;
+      const float eps2s = static_cast<float>(eps2 * inv * inv);
       for (int t = g.t0; t < g.t1; ++t) {
         const int i = ws->order[t];
         const Vec3& p = set.position[i];
@@ -1000,11 +1415,23 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
           detail::sum_pairs(vn, tg, eps2, terms, h, jac);
           if (want_J) detail::sum_pairs(vj, tg, eps2, detail::PairTerms::HJ, unused, jac);
         }
-        if (want_J) {
-          far_sum<true, true>(th.far_hj, order, pp, eps2, h, jac);
-          far_sum<false, true>(th.far_j, order, pp, eps2, h, jac);
+        if (far_float) {
+          // the target relative to the group's centre, in the group's unit L
+          const float pf[3] = {static_cast<float>((p.x() - g.tc[0]) * inv),
+                               static_cast<float>((p.y() - g.tc[1]) * inv),
+                               static_cast<float>((p.z() - g.tc[2]) * inv)};
+          if (want_J) {
+            far_sum_f32<true, true>(th.far_hjf, order, pf, eps2s, sH, sJ, h, jac);
+            far_sum_f32<false, true>(th.far_jf, order, pf, eps2s, sH, sJ, h, jac);
+          }
+          far_sum_f32<true, false>(th.far_hf, order, pf, eps2s, sH, sJ, h, jac);
+        } else {
+          if (want_J) {
+            far_sum<true, true>(th.far_hj, order, pp, eps2, h, jac);
+            far_sum<false, true>(th.far_j, order, pp, eps2, h, jac);
+          }
+          far_sum<true, false>(th.far_h, order, pp, eps2, h, jac);
         }
-        far_sum<true, false>(th.far_h, order, pp, eps2, h, jac);
         (*H)[i] = set.H0 + Vec3(h[0], h[1], h[2]);
         if (want_J) {
           (*J)[i] << jac[0], jac[3], jac[4],

@@ -108,8 +108,8 @@ void sum_pairs_f32(const SourceViewF& v, const TargetF& t, float eps2, PairTerms
 /// 256 with the same error (float vs double near field RMS ~4e-7 either way).
 inline constexpr std::size_t kChunkF = 1024;
 
-/// True when sum_pairs (and the Barnes–Hut far-cell kernel) run the AVX-512 path: the CPU
-/// has it and it has not been switched off.
+/// True when sum_pairs (and the Barnes–Hut far-cell kernels, double and float) run the
+/// AVX-512 path: the CPU has it and it has not been switched off.
 bool simd_kernel_active();
 /// Switches the AVX-512 path off (false) or back on, for tests and benchmarks that compare
 /// it with the portable loop. Not to be called while a field evaluation runs.

@@ -14,7 +14,12 @@
 // --bh-near picks its near field: "double", "float" (FieldOptions::bh_near_float, the
 // default) or "both" (the default here: each θ run with both, and the float one also
 // reports its speed-up over the double one and its difference from it, "near_f32_vs_f64_*":
-// max and RMS relative over every target, as the errors above).
+// max and RMS relative over every target, as the errors above). --bh-far likewise picks
+// the far cells' precision with the float near field (FieldOptions::bh_far_float): "double",
+// "float" or "both" (the default: the float-far run also reports its speed-up over, and its
+// difference from, the double-far one with the same float near field, "far_f32_vs_f64_*").
+// The double near field always runs with double far cells (bh_near_float = false is the
+// all-double sum).
 //
 // Moments: iron balls (radius 4 mm, Ms = 1.6 MA/m) in three layouts — "pile", a packed heap
 // (an FCC packing of touching balls filled layer by layer on a square footprint, about three
@@ -246,7 +251,7 @@ int main(int argc, char** argv) {
   std::string json_path, moments = "scene", groups = "none";
   int repeat = 3, sample = 2048, full_max = 20000, leaf = 64, group = 32, order = 2;
   bool portable = false, no_bh = false;
-  std::string bh_near = "both";
+  std::string bh_near = "both", bh_far = "both";
   app.add_option("--sizes", sizes, "numbers of moments")->delimiter(',');
   app.add_option("--threads", threads, "thread counts")->delimiter(',');
   app.add_option("--theta", thetas, "Barnes–Hut opening angles θ")->delimiter(',');
@@ -276,6 +281,9 @@ int main(int argc, char** argv) {
   app.add_option("--bh-near", bh_near, "Barnes–Hut near field in float, double, or both "
                  "(the default: both timed, float compared with double)")
       ->check(CLI::IsMember({"float", "double", "both"}));
+  app.add_option("--bh-far", bh_far, "Barnes–Hut far cells (with the float near field) in "
+                 "float, double, or both (the default: both timed, float compared with double)")
+      ->check(CLI::IsMember({"float", "double", "both"}));
   CLI11_PARSE(app, argc, argv);
   g_use_min = stat == "min";
   g_cpu_clock = clock == "cpu";
@@ -288,6 +296,7 @@ int main(int argc, char** argv) {
   out["moments"] = moments;
   out["groups"] = groups;
   out["bh_near"] = bh_near;
+  out["bh_far"] = bh_far;
   out["results"] = json::array();
   std::printf("# AVX-512 kernel: %s; %s of %d repeats; pairs/s = targets × sources / time\n",
               mag::detail::simd_kernel_active() ? "yes" : "no", g_use_min ? "min" : "median", repeat);
@@ -412,15 +421,23 @@ int main(int argc, char** argv) {
                       kp / kf_hj, kd_hj / kf_hj, std::isfinite(sink) ? "" : " (non-finite!)");
         }
         rec["barnes_hut"] = json::array();
-        std::vector<bool> near_modes;  // bh_near_float
-        if (bh_near != "float") near_modes.push_back(false);
-        if (bh_near != "double") near_modes.push_back(true);
+        // (bh_near_float, bh_far_float); the far cells in float only with the near field
+        std::vector<std::pair<bool, bool>> modes;
+        if (bh_near != "float") modes.emplace_back(false, false);
+        if (bh_near != "double") {
+          if (bh_far != "float") modes.emplace_back(true, false);
+          if (bh_far != "double") modes.emplace_back(true, true);
+        }
         for (double theta : no_bh ? std::vector<double>{} : thetas) {
          // the double-near run of this θ (for the float one's comparison)
          double tdn_h = 0, tdn_hj = 0, tdn_rh = 0, tdn_rhj = 0;
          std::vector<Vec3> Hdn;
          std::vector<Mat3> Jdn;
-         for (bool near_float : near_modes) {
+         // the float-near, double-far run (for the float-far one's comparison)
+         double tdf_h = 0, tdf_hj = 0, tdf_rh = 0, tdf_rhj = 0;
+         std::vector<Vec3> Hdf;
+         std::vector<Mat3> Jdf;
+         for (const auto& [near_float, far_float] : modes) {
           mag::FieldOptions bh;
           bh.solver = mag::FieldSolver::BarnesHut;
           bh.bh_theta = theta;
@@ -428,6 +445,7 @@ int main(int argc, char** argv) {
           bh.bh_group_size = group;
           bh.bh_order = order;
           bh.bh_near_float = near_float;
+          bh.bh_far_float = far_float;
           // fresh: the geometry forgotten before every call (tree and lists built)
           auto fresh = [&](bool jac) {
             mag::barnes_hut_forget_geometry(&ws);
@@ -444,7 +462,20 @@ int main(int argc, char** argv) {
           if (!near_float) {
             Hdn = H;
             Jdn = J;
-          } else if (!Hdn.empty()) {
+          } else if (!far_float) {
+            Hdf = H;
+            Jdf = J;
+          }
+          if (far_float && !Hdf.empty()) {
+            // float far cells against double ones (the same float near field), every target
+            const Errors d = errors(sample_targets(n, n), H, &J, Hdf, &Jdf);
+            near_cmp = {{"far_f32_vs_f64_H_max", d.h_max}, {"far_f32_vs_f64_H_rms", d.h_rms},
+                        {"far_f32_vs_f64_J_max", d.j_max}, {"far_f32_vs_f64_J_rms", d.j_rms}};
+            char buf[200];
+            std::snprintf(buf, sizeof buf, " | float vs double far: H rms %.2e max %.2e, J rms %.2e max %.2e",
+                          d.h_rms, d.h_max, d.j_rms, d.j_max);
+            near_txt = buf;
+          } else if (near_float && !far_float && !Hdn.empty()) {
             const Errors d = errors(sample_targets(n, n), H, &J, Hdn, &Jdn);
             near_cmp = {{"near_f32_vs_f64_H_max", d.h_max}, {"near_f32_vs_f64_H_rms", d.h_rms},
                         {"near_f32_vs_f64_J_max", d.j_max}, {"near_f32_vs_f64_J_rms", d.j_rms}};
@@ -474,6 +505,7 @@ int main(int argc, char** argv) {
                             std::memcmp(Jr.data(), Jf.data(), Jr.size() * sizeof(Mat3)) == 0;
           json bhrec = {{"theta", theta}, {"leaf", leaf}, {"group", group}, {"order", order},
                                        {"bh_near", near_float ? "float" : "double"},
+                                       {"bh_far", far_float ? "float" : "double"},
                                        {"time_H_s", tb_h}, {"time_HJ_s", tb_hj},
                                        {"speedup_H", td_h / tb_h}, {"speedup_HJ", td_hj / tb_hj},
                                        {"eff_pairs_per_s_H", pairs / tb_h},
@@ -492,7 +524,20 @@ int main(int argc, char** argv) {
                                        {"reuse_bitwise_identical", same}};
           if (!near_float) {
             tdn_h = tb_h; tdn_hj = tb_hj; tdn_rh = tr_h; tdn_rhj = tr_hj;
-          } else if (tdn_h > 0) {
+          } else if (!far_float) {
+            tdf_h = tb_h; tdf_hj = tb_hj; tdf_rh = tr_h; tdf_rhj = tr_hj;
+          }
+          if (far_float && tdf_h > 0) {
+            // speed-ups of the float far cells over the double ones (float near field)
+            bhrec["far_f32_speedup_H"] = tdf_h / tb_h;
+            bhrec["far_f32_speedup_HJ"] = tdf_hj / tb_hj;
+            bhrec["far_f32_speedup_H_reused"] = tdf_rh / tr_h;
+            bhrec["far_f32_speedup_HJ_reused"] = tdf_rhj / tr_hj;
+            char buf[160];
+            std::snprintf(buf, sizeof buf, " | float/double far speed-up: fresh H ×%.2f H+J ×%.2f, reused H ×%.2f H+J ×%.2f",
+                          tdf_h / tb_h, tdf_hj / tb_hj, tdf_rh / tr_h, tdf_rhj / tr_hj);
+            near_txt += buf;
+          } else if (near_float && !far_float && tdn_h > 0) {
             // speed-ups of the float near field over the double one (fresh and reused)
             bhrec["near_f32_speedup_H"] = tdn_h / tb_h;
             bhrec["near_f32_speedup_HJ"] = tdn_hj / tb_hj;
@@ -505,11 +550,12 @@ int main(int argc, char** argv) {
           }
           bhrec.update(near_cmp);
           rec["barnes_hut"].push_back(bhrec);
-          std::printf("%-5s n=%6d threads=%d BH θ=%.2f %s near: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "
+          std::printf("%-5s n=%6d threads=%d BH θ=%.2f %s near %s far: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "
                       "err max %.2e rms %.2e | H+J %8.3f ms (×%5.1f) J err max %.2e rms %.2e "
                       "| near %.0f far %.0f per target | build %.2f lists %.2f eval %.2f ms "
                       "| reused: H %8.3f ms (×%5.1f) H+J %8.3f ms (×%5.1f)%s%s\n",
-                      layout.c_str(), n, nt, theta, near_float ? "float " : "double", tb_h * 1e3, td_h / tb_h, pairs / tb_h, eh.h_max,
+                      layout.c_str(), n, nt, theta, near_float ? "float " : "double",
+                      far_float ? "float " : "double", tb_h * 1e3, td_h / tb_h, pairs / tb_h, eh.h_max,
                       eh.h_rms, tb_hj * 1e3, td_hj / tb_hj, ej.j_max, ej.j_rms,
                       st.near_pairs_per_target, st.far_cells_per_target, st.build_s * 1e3,
                       st.lists_s * 1e3, st.eval_s * 1e3, tr_h * 1e3, td_h / tr_h, tr_hj * 1e3,
