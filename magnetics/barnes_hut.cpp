@@ -896,6 +896,16 @@ MAGSIM_TARGET_AVX512 inline double hsum(V8 v) {
   return ((t[0] + t[4]) + (t[1] + t[5])) + ((t[2] + t[6]) + (t[3] + t[7]));
 }
 
+// The far-cell series of one block of W cells (see far_portable for it written out), the
+// same code in double (V = V8, W = 8) and in single precision (V = V16, W = 16, the cells
+// scaled to the group's unit L): adds 4π h (kH) and 4π J's parts (kJ) of the cells at
+// offsets r = p − c from the target, u2 … u7 the powers of u = 1/√q. Defined below, after
+// the single-precision helpers.
+template <class V, int W, int kOrder, bool kH, bool kJ, class T>
+MAGSIM_TARGET_AVX512 inline void far_block(const T* B, V rx, V ry, V rz, V u2, V u3, V u5, V u7,
+                                           V& hx, V& hy, V& hz, V& ja, V& jxx, V& jyy, V& jzz,
+                                           V& jxy, V& jxz, V& jyz);
+
 template <bool kH, bool kJ, int kOrder>
 MAGSIM_TARGET_AVX512 void far_avx512(const CellBuffer& cb, const double* p, double eps2,
                                      double* Hout, double* Jout) {
@@ -910,93 +920,7 @@ MAGSIM_TARGET_AVX512 void far_avx512(const CellBuffer& cb, const double* p, doub
     const V8 q = fma(rz, rz, fma(ry, ry, fma(rx, rx, e2)));
     const V8 u = rsqrt_pd(q);
     const V8 u2 = mul(u, u), u3 = mul(u2, u), u5 = mul(u3, u2), u7 = mul(u5, u2);
-    const V8 Sxx = ld(B + 8 * kSxx), Syy = ld(B + 8 * kSyy), Szz = ld(B + 8 * kSzz), Sxy = ld(B + 8 * kSxy), Sxz = ld(B + 8 * kSxz),
-             Syz = ld(B + 8 * kSyz);
-    const V8 Mx = ld(B + 8 * kMx), My = ld(B + 8 * kMy), Mz = ld(B + 8 * kMz);
-    const V8 wx = dot3(Sxx, Sxy, Sxz, rx, ry, rz);
-    const V8 wy = dot3(Sxy, Syy, Syz, rx, ry, rz);
-    const V8 wz = dot3(Sxz, Syz, Szz, rx, ry, rz);
-    const V8 s = dot3(rx, ry, rz, wx, wy, wz);
-    const V8 rho = sub(dot3(rx, ry, rz, Mx, My, Mz), ld(B + 8 * kTrS));
-    V8 oxx = zero, oyy = zero, ozz = zero, oxy = zero, oxz = zero, oyz = zero;
-    V8 o2x = zero, o2y = zero, o2z = zero, o3 = zero, tau = zero, tx = zero, ty = zero,
-       tz = zero, u9 = zero;
-    V8 A = fma(mul(set1(3.0), rho), u5, mul(mul(set1(15.0), s), u7));
-    if constexpr (kOrder >= 2) {
-      const V8 Oxxy = ld(B + 8 * kOxxy), Oxxz = ld(B + 8 * kOxxz), Oxyy = ld(B + 8 * kOxyy), Oyyz = ld(B + 8 * kOyyz),
-               Oxzz = ld(B + 8 * kOxzz), Oyzz = ld(B + 8 * kOyzz), Oxyz = ld(B + 8 * kOxyz);
-      oxx = dot3(ld(B + 8 * kOxxx), Oxxy, Oxxz, rx, ry, rz);
-      oyy = dot3(Oxyy, ld(B + 8 * kOyyy), Oyyz, rx, ry, rz);
-      ozz = dot3(Oxzz, Oyzz, ld(B + 8 * kOzzz), rx, ry, rz);
-      oxy = dot3(Oxxy, Oxyy, Oxyz, rx, ry, rz);
-      oxz = dot3(Oxxz, Oxyz, Oxzz, rx, ry, rz);
-      oyz = dot3(Oxyz, Oyyz, Oyzz, rx, ry, rz);
-      o2x = dot3(oxx, oxy, oxz, rx, ry, rz);
-      o2y = dot3(oxy, oyy, oyz, rx, ry, rz);
-      o2z = dot3(oxz, oyz, ozz, rx, ry, rz);
-      o3 = dot3(o2x, o2y, o2z, rx, ry, rz);
-      tx = ld(B + 8 * kTx); ty = ld(B + 8 * kTy); tz = ld(B + 8 * kTz);
-      tau = dot3(tx, ty, tz, rx, ry, rz);
-      u9 = mul(u7, u2);
-      A = fma(mul(set1(52.5), o3), u9, fnma(mul(set1(22.5), tau), u7, A));
-    }
-    if constexpr (kH) {
-      // h = A r − u3 M − u5 v − 22.5 u7 o2,  v = 6 w − 4.5 t
-      const V8 c6 = set1(6.0);
-      V8 vx = mul(c6, wx), vy = mul(c6, wy), vz = mul(c6, wz);
-      if constexpr (kOrder >= 2) {
-        const V8 c45 = set1(4.5), u7_225 = mul(set1(22.5), u7);
-        vx = fnma(c45, tx, vx);
-        vy = fnma(c45, ty, vy);
-        vz = fnma(c45, tz, vz);
-        hx = fnma(u7_225, o2x, hx);
-        hy = fnma(u7_225, o2y, hy);
-        hz = fnma(u7_225, o2z, hz);
-      }
-      hx = fnma(u3, Mx, fnma(u5, vx, fma(A, rx, hx)));
-      hy = fnma(u3, My, fnma(u5, vy, fma(A, ry, hy)));
-      hz = fnma(u3, Mz, fnma(u5, vz, fma(A, rz, hz)));
-    }
-    if constexpr (kJ) {
-      // K = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
-      if constexpr (kOrder < 2) u9 = mul(u7, u2);
-      V8 cr = fnma(mul(set1(7.5), rho), u7, mul(mul(set1(-52.5), s), u9));
-      const V8 u5_3m = mul(set1(3.0), u5), u7_30 = mul(set1(30.0), u7);
-      V8 Kx = fma(u7_30, wx, mul(u5_3m, Mx));
-      V8 Ky = fma(u7_30, wy, mul(u5_3m, My));
-      V8 Kz = fma(u7_30, wz, mul(u5_3m, Mz));
-      if constexpr (kOrder >= 2) {
-        const V8 u11 = mul(u9, u2);
-        cr = fnma(mul(set1(236.25), o3), u11, fma(mul(set1(78.75), tau), u9, cr));
-        const V8 u7_225 = mul(set1(22.5), u7), u9_1575 = mul(set1(157.5), u9);
-        Kx = fma(u9_1575, o2x, fnma(u7_225, tx, Kx));
-        Ky = fma(u9_1575, o2y, fnma(u7_225, ty, Ky));
-        Kz = fma(u9_1575, o2z, fnma(u7_225, tz, Kz));
-      }
-      Kx = fma(cr, rx, Kx);
-      Ky = fma(cr, ry, Ky);
-      Kz = fma(cr, rz, Kz);
-      // J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1; the diagonal sums hold half of their
-      // r K, S and o1 terms (doubled at the end)
-      const V8 u5_3 = mul(set1(3.0), u5), u5_6 = mul(set1(6.0), u5);
-      ja = add(ja, A);
-      V8 dxx = fnma(u5_3, Sxx, mul(rx, Kx)), dyy = fnma(u5_3, Syy, mul(ry, Ky)),
-         dzz = fnma(u5_3, Szz, mul(rz, Kz));
-      V8 dxy = fnma(u5_6, Sxy, fma(ry, Kx, mul(rx, Ky)));
-      V8 dxz = fnma(u5_6, Sxz, fma(rz, Kx, mul(rx, Kz)));
-      V8 dyz = fnma(u5_6, Syz, fma(rz, Ky, mul(ry, Kz)));
-      if constexpr (kOrder >= 2) {
-        const V8 u7_225 = mul(set1(22.5), u7), u7_45 = mul(set1(45.0), u7);
-        dxx = fnma(u7_225, oxx, dxx);
-        dyy = fnma(u7_225, oyy, dyy);
-        dzz = fnma(u7_225, ozz, dzz);
-        dxy = fnma(u7_45, oxy, dxy);
-        dxz = fnma(u7_45, oxz, dxz);
-        dyz = fnma(u7_45, oyz, dyz);
-      }
-      jxx = add(jxx, dxx); jyy = add(jyy, dyy); jzz = add(jzz, dzz);
-      jxy = add(jxy, dxy); jxz = add(jxz, dxz); jyz = add(jyz, dyz);
-    }
+    far_block<V8, 8, kOrder, kH, kJ>(B, rx, ry, rz, u2, u3, u5, u7, hx, hy, hz, ja, jxx, jyy, jzz, jxy, jxz, jyz);
   }
   if constexpr (kH) {
     Hout[0] += hsum(hx) * kInv4Pi; Hout[1] += hsum(hy) * kInv4Pi; Hout[2] += hsum(hz) * kInv4Pi;
@@ -1161,6 +1085,110 @@ MAGSIM_TARGET_AVX512 inline V8 widen_add(V8 acc, V16 v) {
   return add(acc, add(_mm512_maskz_cvtps_pd(0xff, l), _mm512_maskz_cvtps_pd(0xff, h)));
 }
 
+// A constant in every lane of V (overloads on a V argument, whose value is ignored).
+MAGSIM_TARGET_AVX512 inline V8 splat(V8, double x) { return _mm512_set1_pd(x); }
+MAGSIM_TARGET_AVX512 inline V16 splat(V16, double x) { return _mm512_set1_ps(static_cast<float>(x)); }
+template <class V>
+MAGSIM_TARGET_AVX512 inline V cst(double x) { return splat(V(), x); }
+MAGSIM_TARGET_AVX512 inline V16 ld(const float* p) { return _mm512_loadu_ps(p); }
+
+template <class V, int W, int kOrder, bool kH, bool kJ, class T>
+MAGSIM_TARGET_AVX512 inline void far_block(const T* B, V rx, V ry, V rz, V u2, V u3, V u5, V u7,
+                                           V& hx, V& hy, V& hz, V& ja, V& jxx, V& jyy, V& jzz,
+                                           V& jxy, V& jxz, V& jyz) {
+  const V zero = cst<V>(0.0);
+  const V Sxx = ld(B + W * kSxx), Syy = ld(B + W * kSyy), Szz = ld(B + W * kSzz),
+            Sxy = ld(B + W * kSxy), Sxz = ld(B + W * kSxz), Syz = ld(B + W * kSyz);
+  const V Mx = ld(B + W * kMx), My = ld(B + W * kMy), Mz = ld(B + W * kMz);
+  const V wx = dot3(Sxx, Sxy, Sxz, rx, ry, rz);
+  const V wy = dot3(Sxy, Syy, Syz, rx, ry, rz);
+  const V wz = dot3(Sxz, Syz, Szz, rx, ry, rz);
+  const V s = dot3(rx, ry, rz, wx, wy, wz);
+  const V rho = sub(dot3(rx, ry, rz, Mx, My, Mz), ld(B + W * kTrS));
+  V oxx = zero, oyy = zero, ozz = zero, oxy = zero, oxz = zero, oyz = zero;
+  V o2x = zero, o2y = zero, o2z = zero, o3 = zero, tau = zero, tx = zero, ty = zero,
+      tz = zero, u9 = zero;
+  // A = 3ρ u5 + (15 s − 22.5 τ) u7 + 52.5 o3 u9
+  V A = fma(mul(cst<V>(3.0), rho), u5, mul(mul(cst<V>(15.0), s), u7));
+  if constexpr (kOrder >= 2) {
+    const V Oxxy = ld(B + W * kOxxy), Oxxz = ld(B + W * kOxxz), Oxyy = ld(B + W * kOxyy),
+              Oyyz = ld(B + W * kOyyz), Oxzz = ld(B + W * kOxzz), Oyzz = ld(B + W * kOyzz),
+              Oxyz = ld(B + W * kOxyz);
+    oxx = dot3(ld(B + W * kOxxx), Oxxy, Oxxz, rx, ry, rz);
+    oyy = dot3(Oxyy, ld(B + W * kOyyy), Oyyz, rx, ry, rz);
+    ozz = dot3(Oxzz, Oyzz, ld(B + W * kOzzz), rx, ry, rz);
+    oxy = dot3(Oxxy, Oxyy, Oxyz, rx, ry, rz);
+    oxz = dot3(Oxxz, Oxyz, Oxzz, rx, ry, rz);
+    oyz = dot3(Oxyz, Oyyz, Oyzz, rx, ry, rz);
+    o2x = dot3(oxx, oxy, oxz, rx, ry, rz);
+    o2y = dot3(oxy, oyy, oyz, rx, ry, rz);
+    o2z = dot3(oxz, oyz, ozz, rx, ry, rz);
+    o3 = dot3(o2x, o2y, o2z, rx, ry, rz);
+    tx = ld(B + W * kTx); ty = ld(B + W * kTy); tz = ld(B + W * kTz);
+    tau = dot3(tx, ty, tz, rx, ry, rz);
+    u9 = mul(u7, u2);
+    A = fma(mul(cst<V>(52.5), o3), u9, fnma(mul(cst<V>(22.5), tau), u7, A));
+  }
+  if constexpr (kH) {
+    // 4π h = A r − u3 M − u5 v − 22.5 u7 o2,  v = 6 w − 4.5 t
+    const V c6 = cst<V>(6.0);
+    V vx = mul(c6, wx), vy = mul(c6, wy), vz = mul(c6, wz);
+    if constexpr (kOrder >= 2) {
+      const V c45 = cst<V>(4.5), u7_225 = mul(cst<V>(22.5), u7);
+      vx = fnma(c45, tx, vx);
+      vy = fnma(c45, ty, vy);
+      vz = fnma(c45, tz, vz);
+      hx = fnma(u7_225, o2x, hx);
+      hy = fnma(u7_225, o2y, hy);
+      hz = fnma(u7_225, o2z, hz);
+    }
+    hx = fnma(u3, Mx, fnma(u5, vx, fma(A, rx, hx)));
+    hy = fnma(u3, My, fnma(u5, vy, fma(A, ry, hy)));
+    hz = fnma(u3, Mz, fnma(u5, vz, fma(A, rz, hz)));
+  }
+  if constexpr (kJ) {
+    // c_r = −7.5 ρ u7 + (78.75 τ − 52.5 s) u9 − 236.25 o3 u11
+    // K = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
+    if constexpr (kOrder < 2) u9 = mul(u7, u2);
+    V cr = fnma(mul(cst<V>(7.5), rho), u7, mul(mul(cst<V>(-52.5), s), u9));
+    const V u5_3m = mul(cst<V>(3.0), u5), u7_30 = mul(cst<V>(30.0), u7);
+    V Kx = fma(u7_30, wx, mul(u5_3m, Mx));
+    V Ky = fma(u7_30, wy, mul(u5_3m, My));
+    V Kz = fma(u7_30, wz, mul(u5_3m, Mz));
+    if constexpr (kOrder >= 2) {
+      const V u11 = mul(u9, u2);
+      cr = fnma(mul(cst<V>(236.25), o3), u11, fma(mul(cst<V>(78.75), tau), u9, cr));
+      const V u7_225 = mul(cst<V>(22.5), u7), u9_1575 = mul(cst<V>(157.5), u9);
+      Kx = fma(u9_1575, o2x, fnma(u7_225, tx, Kx));
+      Ky = fma(u9_1575, o2y, fnma(u7_225, ty, Ky));
+      Kz = fma(u9_1575, o2z, fnma(u7_225, tz, Kz));
+    }
+    Kx = fma(cr, rx, Kx);
+    Ky = fma(cr, ry, Ky);
+    Kz = fma(cr, rz, Kz);
+    // 4π J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1; the diagonal sums hold half of their
+    // r K, S and o1 terms (doubled at the end)
+    const V u5_3 = mul(cst<V>(3.0), u5), u5_6 = mul(cst<V>(6.0), u5);
+    ja = add(ja, A);
+    V dxx = fnma(u5_3, Sxx, mul(rx, Kx)), dyy = fnma(u5_3, Syy, mul(ry, Ky)),
+        dzz = fnma(u5_3, Szz, mul(rz, Kz));
+    V dxy = fnma(u5_6, Sxy, fma(ry, Kx, mul(rx, Ky)));
+    V dxz = fnma(u5_6, Sxz, fma(rz, Kx, mul(rx, Kz)));
+    V dyz = fnma(u5_6, Syz, fma(rz, Ky, mul(ry, Kz)));
+    if constexpr (kOrder >= 2) {
+      const V u7_225 = mul(cst<V>(22.5), u7), u7_45 = mul(cst<V>(45.0), u7);
+      dxx = fnma(u7_225, oxx, dxx);
+      dyy = fnma(u7_225, oyy, dyy);
+      dzz = fnma(u7_225, ozz, dzz);
+      dxy = fnma(u7_45, oxy, dxy);
+      dxz = fnma(u7_45, oxz, dxz);
+      dyz = fnma(u7_45, oyz, dyz);
+    }
+    jxx = add(jxx, dxx); jyy = add(jyy, dyy); jzz = add(jzz, dzz);
+    jxy = add(jxy, dxy); jxz = add(jxz, dxz); jyz = add(jyz, dyz);
+  }
+}
+
 template <bool kH, bool kJ, int kOrder>
 MAGSIM_TARGET_AVX512 void far_f32_avx512(const CellBufferF& cb, const float* p, float eps2,
                                          double sH, double sJ, double* Hout, double* Jout) {
@@ -1183,96 +1211,7 @@ MAGSIM_TARGET_AVX512 void far_f32_avx512(const CellBufferF& cb, const float* p, 
     const V16 q = fma(rz, rz, fma(ry, ry, fma(rx, rx, e2)));
     const V16 u = rsqrt_ps(keep, q);
     const V16 u2 = mul(u, u), u3 = mul(u2, u), u5 = mul(u3, u2), u7 = mul(u5, u2);
-    const V16 Sxx = fld(B + 16 * kSxx), Syy = fld(B + 16 * kSyy), Szz = fld(B + 16 * kSzz),
-              Sxy = fld(B + 16 * kSxy), Sxz = fld(B + 16 * kSxz), Syz = fld(B + 16 * kSyz);
-    const V16 Mx = fld(B + 16 * kMx), My = fld(B + 16 * kMy), Mz = fld(B + 16 * kMz);
-    const V16 wx = dot3(Sxx, Sxy, Sxz, rx, ry, rz);
-    const V16 wy = dot3(Sxy, Syy, Syz, rx, ry, rz);
-    const V16 wz = dot3(Sxz, Syz, Szz, rx, ry, rz);
-    const V16 s = dot3(rx, ry, rz, wx, wy, wz);
-    const V16 rho = sub(dot3(rx, ry, rz, Mx, My, Mz), fld(B + 16 * kTrS));
-    V16 oxx = zero, oyy = zero, ozz = zero, oxy = zero, oxz = zero, oyz = zero;
-    V16 o2x = zero, o2y = zero, o2z = zero, o3 = zero, tau = zero, tx = zero, ty = zero,
-        tz = zero, u9 = zero;
-    // A = 3ρ u5 + (15 s − 22.5 τ) u7 + 52.5 o3 u9
-    V16 A = fma(mul(fset1(3.0f), rho), u5, mul(mul(fset1(15.0f), s), u7));
-    if constexpr (kOrder >= 2) {
-      const V16 Oxxy = fld(B + 16 * kOxxy), Oxxz = fld(B + 16 * kOxxz), Oxyy = fld(B + 16 * kOxyy),
-                Oyyz = fld(B + 16 * kOyyz), Oxzz = fld(B + 16 * kOxzz), Oyzz = fld(B + 16 * kOyzz),
-                Oxyz = fld(B + 16 * kOxyz);
-      oxx = dot3(fld(B + 16 * kOxxx), Oxxy, Oxxz, rx, ry, rz);
-      oyy = dot3(Oxyy, fld(B + 16 * kOyyy), Oyyz, rx, ry, rz);
-      ozz = dot3(Oxzz, Oyzz, fld(B + 16 * kOzzz), rx, ry, rz);
-      oxy = dot3(Oxxy, Oxyy, Oxyz, rx, ry, rz);
-      oxz = dot3(Oxxz, Oxyz, Oxzz, rx, ry, rz);
-      oyz = dot3(Oxyz, Oyyz, Oyzz, rx, ry, rz);
-      o2x = dot3(oxx, oxy, oxz, rx, ry, rz);
-      o2y = dot3(oxy, oyy, oyz, rx, ry, rz);
-      o2z = dot3(oxz, oyz, ozz, rx, ry, rz);
-      o3 = dot3(o2x, o2y, o2z, rx, ry, rz);
-      tx = fld(B + 16 * kTx); ty = fld(B + 16 * kTy); tz = fld(B + 16 * kTz);
-      tau = dot3(tx, ty, tz, rx, ry, rz);
-      u9 = mul(u7, u2);
-      A = fma(mul(fset1(52.5f), o3), u9, fnma(mul(fset1(22.5f), tau), u7, A));
-    }
-    if constexpr (kH) {
-      // 4π h = A r − u3 M − u5 v − 22.5 u7 o2,  v = 6 w − 4.5 t
-      const V16 c6 = fset1(6.0f);
-      V16 vx = mul(c6, wx), vy = mul(c6, wy), vz = mul(c6, wz);
-      if constexpr (kOrder >= 2) {
-        const V16 c45 = fset1(4.5f), u7_225 = mul(fset1(22.5f), u7);
-        vx = fnma(c45, tx, vx);
-        vy = fnma(c45, ty, vy);
-        vz = fnma(c45, tz, vz);
-        hx = fnma(u7_225, o2x, hx);
-        hy = fnma(u7_225, o2y, hy);
-        hz = fnma(u7_225, o2z, hz);
-      }
-      hx = fnma(u3, Mx, fnma(u5, vx, fma(A, rx, hx)));
-      hy = fnma(u3, My, fnma(u5, vy, fma(A, ry, hy)));
-      hz = fnma(u3, Mz, fnma(u5, vz, fma(A, rz, hz)));
-    }
-    if constexpr (kJ) {
-      // c_r = −7.5 ρ u7 + (78.75 τ − 52.5 s) u9 − 236.25 o3 u11
-      // K = 3 u5 M + 30 u7 w − 22.5 u7 t + 157.5 u9 o2 + c_r r
-      if constexpr (kOrder < 2) u9 = mul(u7, u2);
-      V16 cr = fnma(mul(fset1(7.5f), rho), u7, mul(mul(fset1(-52.5f), s), u9));
-      const V16 u5_3m = mul(fset1(3.0f), u5), u7_30 = mul(fset1(30.0f), u7);
-      V16 Kx = fma(u7_30, wx, mul(u5_3m, Mx));
-      V16 Ky = fma(u7_30, wy, mul(u5_3m, My));
-      V16 Kz = fma(u7_30, wz, mul(u5_3m, Mz));
-      if constexpr (kOrder >= 2) {
-        const V16 u11 = mul(u9, u2);
-        cr = fnma(mul(fset1(236.25f), o3), u11, fma(mul(fset1(78.75f), tau), u9, cr));
-        const V16 u7_225 = mul(fset1(22.5f), u7), u9_1575 = mul(fset1(157.5f), u9);
-        Kx = fma(u9_1575, o2x, fnma(u7_225, tx, Kx));
-        Ky = fma(u9_1575, o2y, fnma(u7_225, ty, Ky));
-        Kz = fma(u9_1575, o2z, fnma(u7_225, tz, Kz));
-      }
-      Kx = fma(cr, rx, Kx);
-      Ky = fma(cr, ry, Ky);
-      Kz = fma(cr, rz, Kz);
-      // 4π J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1; the diagonal sums hold half of their
-      // r K, S and o1 terms (doubled at the end)
-      const V16 u5_3 = mul(fset1(3.0f), u5), u5_6 = mul(fset1(6.0f), u5);
-      ja = add(ja, A);
-      V16 dxx = fnma(u5_3, Sxx, mul(rx, Kx)), dyy = fnma(u5_3, Syy, mul(ry, Ky)),
-          dzz = fnma(u5_3, Szz, mul(rz, Kz));
-      V16 dxy = fnma(u5_6, Sxy, fma(ry, Kx, mul(rx, Ky)));
-      V16 dxz = fnma(u5_6, Sxz, fma(rz, Kx, mul(rx, Kz)));
-      V16 dyz = fnma(u5_6, Syz, fma(rz, Ky, mul(ry, Kz)));
-      if constexpr (kOrder >= 2) {
-        const V16 u7_225 = mul(fset1(22.5f), u7), u7_45 = mul(fset1(45.0f), u7);
-        dxx = fnma(u7_225, oxx, dxx);
-        dyy = fnma(u7_225, oyy, dyy);
-        dzz = fnma(u7_225, ozz, dzz);
-        dxy = fnma(u7_45, oxy, dxy);
-        dxz = fnma(u7_45, oxz, dxz);
-        dyz = fnma(u7_45, oyz, dyz);
-      }
-      jxx = add(jxx, dxx); jyy = add(jyy, dyy); jzz = add(jzz, dzz);
-      jxy = add(jxy, dxy); jxz = add(jxz, dxz); jyz = add(jyz, dyz);
-    }
+    far_block<V16, 16, kOrder, kH, kJ>(B, rx, ry, rz, u2, u3, u5, u7, hx, hy, hz, ja, jxx, jyy, jzz, jxy, jxz, jyz);
     }
     if constexpr (kH) {
       acc[0] = widen_add(acc[0], hx); acc[1] = widen_add(acc[1], hy); acc[2] = widen_add(acc[2], hz);
