@@ -527,27 +527,21 @@ int main(int argc, char** argv) {
           } else if (!far_float) {
             tdf_h = tb_h; tdf_hj = tb_hj; tdf_rh = tr_h; tdf_rhj = tr_hj;
           }
-          if (far_float && tdf_h > 0) {
-            // speed-ups of the float far cells over the double ones (float near field)
-            bhrec["far_f32_speedup_H"] = tdf_h / tb_h;
-            bhrec["far_f32_speedup_HJ"] = tdf_hj / tb_hj;
-            bhrec["far_f32_speedup_H_reused"] = tdf_rh / tr_h;
-            bhrec["far_f32_speedup_HJ_reused"] = tdf_rhj / tr_hj;
+          // speed-ups of the float part over the double one (fresh and reused): the far
+          // cells (float near field in both), or else the near field (far cells in double)
+          auto speedup = [&](const char* part, double h, double hj, double rh, double rhj) {
+            const std::string k = std::string(part) + "_f32_speedup_";
+            bhrec[k + "H"] = h / tb_h;
+            bhrec[k + "HJ"] = hj / tb_hj;
+            bhrec[k + "H_reused"] = rh / tr_h;
+            bhrec[k + "HJ_reused"] = rhj / tr_hj;
             char buf[160];
-            std::snprintf(buf, sizeof buf, " | float/double far speed-up: fresh H ×%.2f H+J ×%.2f, reused H ×%.2f H+J ×%.2f",
-                          tdf_h / tb_h, tdf_hj / tb_hj, tdf_rh / tr_h, tdf_rhj / tr_hj);
+            std::snprintf(buf, sizeof buf, " | float/double %s speed-up: fresh H ×%.2f H+J ×%.2f, reused H ×%.2f H+J ×%.2f",
+                          part, h / tb_h, hj / tb_hj, rh / tr_h, rhj / tr_hj);
             near_txt += buf;
-          } else if (near_float && !far_float && tdn_h > 0) {
-            // speed-ups of the float near field over the double one (fresh and reused)
-            bhrec["near_f32_speedup_H"] = tdn_h / tb_h;
-            bhrec["near_f32_speedup_HJ"] = tdn_hj / tb_hj;
-            bhrec["near_f32_speedup_H_reused"] = tdn_rh / tr_h;
-            bhrec["near_f32_speedup_HJ_reused"] = tdn_rhj / tr_hj;
-            char buf[160];
-            std::snprintf(buf, sizeof buf, " | float/double near speed-up: fresh H ×%.2f H+J ×%.2f, reused H ×%.2f H+J ×%.2f",
-                          tdn_h / tb_h, tdn_hj / tb_hj, tdn_rh / tr_h, tdn_rhj / tr_hj);
-            near_txt += buf;
-          }
+          };
+          if (far_float && tdf_h > 0) speedup("far", tdf_h, tdf_hj, tdf_rh, tdf_rhj);
+          else if (near_float && !far_float && tdn_h > 0) speedup("near", tdn_h, tdn_hj, tdn_rh, tdn_rhj);
           bhrec.update(near_cmp);
           rec["barnes_hut"].push_back(bhrec);
           std::printf("%-5s n=%6d threads=%d BH θ=%.2f %s near %s far: H %8.3f ms (×%5.1f, %.3g eff. pairs/s) "

@@ -424,17 +424,18 @@ MomentSet sheet(int n) {
   return s;
 }
 
-// Barnes–Hut with the float near field against Barnes–Hut with the double one (the same
-// tree, lists and far field — kept in double by bh_far_float = false: the difference is
-// the near field's rounding alone).
-Errors float_vs_double_near(const MomentSet& s, FieldOptions o) {
+// Barnes–Hut with one part in single precision against the same with that part in double
+// (the same tree and lists): `part` = &FieldOptions::bh_near_float compares the near fields
+// with the far cells in double in both; &FieldOptions::bh_far_float the far cells with the
+// near field in float in both. The difference is that part's rounding alone.
+Errors float_vs_double(const MomentSet& s, FieldOptions o, bool FieldOptions::*part) {
   FieldWorkspace ws;
   std::vector<Vec3> Hf, Hd;
   std::vector<Mat3> Jf, Jd;
-  o.bh_far_float = false;
   o.bh_near_float = true;
+  o.bh_far_float = part == &FieldOptions::bh_far_float;
   compute_fields(s, o, &Hf, &Jf, &ws);
-  o.bh_near_float = false;
+  o.*part = false;
   compute_fields(s, o, &Hd, &Jd, &ws);
   return compare(Hf, Jf, Hd, Jd);
 }
@@ -458,7 +459,7 @@ TEST_CASE("Barnes–Hut float near field: within 1e-5 (RMS) of the double one, H
       for (std::size_t j = 0; j < s.size(); ++j) s.group[j] = static_cast<std::int32_t>(j);
     FieldOptions o = bh_options(FieldOptions{}.bh_theta);
     o.softening = c.softening;
-    const Errors e = float_vs_double_near(s, o);
+    const Errors e = float_vs_double(s, o, &FieldOptions::bh_near_float);
     INFO(c.name << ": float vs double near: H rms " << e.h_rms << " max " << e.h_max
                 << "; J rms " << e.j_rms << " max " << e.j_max);
     CHECK(e.h_rms <= 1e-5);
@@ -561,24 +562,6 @@ TEST_CASE("Barnes–Hut float near field: AVX-512 and portable kernels agree to 
 
 // ---- single-precision far cells (FieldOptions::bh_far_float, with bh_near_float) --------
 
-namespace {
-
-// Barnes–Hut with float far cells against double ones, the near field in float in both
-// (the same tree and lists: the difference is the far cells' rounding alone).
-Errors float_vs_double_far(const MomentSet& s, FieldOptions o) {
-  FieldWorkspace ws;
-  std::vector<Vec3> Hf, Hd;
-  std::vector<Mat3> Jf, Jd;
-  o.bh_near_float = true;
-  o.bh_far_float = true;
-  compute_fields(s, o, &Hf, &Jf, &ws);
-  o.bh_far_float = false;
-  compute_fields(s, o, &Hd, &Jd, &ws);
-  return compare(Hf, Jf, Hd, Jd);
-}
-
-}  // namespace
-
 TEST_CASE("Barnes–Hut float far cells: within 1e-5 (RMS) of the double ones, H and J",
           "[barnes-hut]") {
   // Measured (RMS relative, H / J; see barnes_hut.hpp): ~1e-9 … 3e-7; the bound leaves
@@ -599,7 +582,7 @@ TEST_CASE("Barnes–Hut float far cells: within 1e-5 (RMS) of the double ones, H
     FieldOptions o = bh_options(FieldOptions{}.bh_theta);
     o.softening = c.softening;
     o.bh_order = c.order;
-    const Errors e = float_vs_double_far(s, o);
+    const Errors e = float_vs_double(s, o, &FieldOptions::bh_far_float);
     INFO(c.name << ": float vs double far: H rms " << e.h_rms << " max " << e.h_max
                 << "; J rms " << e.j_rms << " max " << e.j_max);
     CHECK(e.h_rms <= 1e-5);
@@ -624,7 +607,7 @@ TEST_CASE("Barnes–Hut float far cells: within 1e-5 (RMS) of the double ones, H
     FieldOptions o = bh_options(FieldOptions{}.bh_theta);
     o.bh_leaf_size = 1;
     o.bh_group_size = 1;
-    const Errors e = float_vs_double_far(s, o);
+    const Errors e = float_vs_double(s, o, &FieldOptions::bh_far_float);
     INFO("length × " << k << ": float vs double far: H rms " << e.h_rms << "; J rms " << e.j_rms);
     CHECK(std::isfinite(e.h_rms));
     CHECK(std::isfinite(e.j_rms));
