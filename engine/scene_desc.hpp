@@ -59,6 +59,25 @@ struct BodyDesc {
 
 enum class SpaceKind { Hash, SweepAndPrune, Simple };
 
+/// "hash", "sap", "simple" (scene files, --space, summary.json).
+inline const char* space_name(SpaceKind k) {
+  switch (k) {
+    case SpaceKind::Hash: return "hash";
+    case SpaceKind::SweepAndPrune: return "sap";
+    case SpaceKind::Simple: return "simple";
+  }
+  return "?";
+}
+/// Parses a broad-phase name; returns false (and leaves *out alone) on an unknown name.
+inline bool parse_space(const std::string& name, SpaceKind* out) {
+  for (SpaceKind k : {SpaceKind::Hash, SpaceKind::SweepAndPrune, SpaceKind::Simple})
+    if (name == space_name(k)) {
+      *out = k;
+      return true;
+    }
+  return false;
+}
+
 /// Run options. Defaults are the engine's; each scene overrides what it needs.
 struct SimOptions {
   /// The paper's θ dynamics with the sub-pair re-aligned (DESIGN §6): the paper's literal

@@ -207,9 +207,8 @@ BodyType body_type(const Reader& r, const json& j, const std::string& path) {
 
 SpaceKind space_kind(const Reader& r, const json& j, const std::string& path) {
   const std::string s = r.string(j, path);
-  if (s == "hash") return SpaceKind::Hash;
-  if (s == "sap") return SpaceKind::SweepAndPrune;
-  if (s == "simple") return SpaceKind::Simple;
+  SpaceKind k;
+  if (engine::parse_space(s, &k)) return k;
   r.fail(path, "unknown space '" + s + "' (hash, sap, simple)");
 }
 

@@ -109,10 +109,8 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
   if (app.count("--auto-disable")) s.options.auto_disable = true;
   if (app.count("--space")) {
-    if (a.space == "hash") s.options.space = engine::SpaceKind::Hash;
-    else if (a.space == "sap") s.options.space = engine::SpaceKind::SweepAndPrune;
-    else if (a.space == "simple") s.options.space = engine::SpaceKind::Simple;
-    else throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
+    if (!engine::parse_space(a.space, &s.options.space))
+      throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
   }
   mag::FieldOptions& f = s.options.magnetics.field;
   try {
@@ -156,15 +154,6 @@ double sum(const std::vector<double>& v) {
 }
 
 json vec3(const engine::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
-
-const char* space_name(engine::SpaceKind k) {
-  switch (k) {
-    case engine::SpaceKind::Hash: return "hash";
-    case engine::SpaceKind::SweepAndPrune: return "sap";
-    case engine::SpaceKind::Simple: return "simple";
-  }
-  return "?";
-}
 
 // Per-frame output: states.csv and moments.csv rows, and the series of summary.json.
 class Recorder {
@@ -257,7 +246,7 @@ json options_json(const engine::Model& m) {
               {"cfm", o.cfm},
               {"quickstep_iterations", o.quickstep_iterations},
               {"max_contacts", o.max_contacts},
-              {"space", space_name(o.space)},
+              {"space", engine::space_name(o.space)},
               {"auto_disable", o.auto_disable},
               {"linear_damping", o.linear_damping},
               {"angular_damping", o.angular_damping},
