@@ -12,7 +12,11 @@ namespace magsim::engine {
 
 void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
   const mag::Method method = m.options.method;
-  mag::compute_forces(set, mag::force_model_of(method), mag::curve_of(method),
+  const ForceChoice fc = m.options.force_model;
+  const mag::ForceModel model = fc == ForceChoice::Zeeman    ? mag::ForceModel::Zeeman
+                                : fc == ForceChoice::Classic ? mag::ForceModel::Classic
+                                                             : mag::force_model_of(method);
+  mag::compute_forces(set, model, mag::curve_of(method),
                       m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
                       m.options.reaction_symmetric_forces);
 }

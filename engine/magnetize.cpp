@@ -13,16 +13,16 @@ void magnetize(const Model& m, mag::MomentSet* set, Workspace* ws, StepProfile* 
   const mag::DynamicsOptions& opt = m.options.magnetics;
   if (m.options.method == mag::Method::Exact) {
     const mag::ExactStats st = mag::solve_exact(set, mag::curve_of(mag::Method::Exact), opt.field);
-    prof->iterations = st.newton_steps;
-    prof->converged = st.converged;
-    prof->cap_hit = !st.converged;
+    prof->iterations += st.newton_steps;
+    prof->converged = prof->converged && st.converged;
+    prof->cap_hit = prof->cap_hit || !st.converged;
     prof->last_change = st.residual;
     return;
   }
   const mag::RelaxStats st = mag::relax_magnetization(set, opt, &ws->mag);
-  prof->iterations = st.iterations;
-  prof->converged = st.converged;
-  prof->cap_hit = !st.converged;
+  prof->iterations += st.iterations;  // summed over the frame's sub-steps
+  prof->converged = prof->converged && st.converged;
+  prof->cap_hit = prof->cap_hit || !st.converged;
   prof->last_change = st.last_change;
 }
 

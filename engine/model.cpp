@@ -49,6 +49,8 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (!(o.cfm >= 0 && std::isfinite(o.cfm))) fail("options.cfm", "must be >= 0 and finite (got " + fmt(o.cfm) + ")");
   if (o.quickstep_iterations < 1)
     fail("options.quickstep_iterations", "must be >= 1 (got " + std::to_string(o.quickstep_iterations) + ")");
+  if (!(o.quickstep_w > 0 && o.quickstep_w < 2))
+    fail("options.quickstep_w", "must be in (0, 2) (got " + fmt(o.quickstep_w) + ")");
   if (o.max_contacts < 1 || o.max_contacts > 64)
     fail("options.max_contacts", "must be in [1, 64] (got " + std::to_string(o.max_contacts) + ")");
   if (!(o.linear_damping >= 0 && std::isfinite(o.linear_damping)))
@@ -62,6 +64,12 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (!std::isfinite(o.contact_margin))
     fail("options.contact_margin", "must be finite (< 0 = auto, 0 = off) (got " + fmt(o.contact_margin) + ")");
   if (o.threads < 0) fail("options.threads", "must be >= 0 (got " + std::to_string(o.threads) + ")");
+  if (!(o.rolling_friction >= 0 && std::isfinite(o.rolling_friction)))
+    fail("options.rolling_friction", "must be >= 0 and finite (m) (got " + fmt(o.rolling_friction) + ")");
+  if (o.max_substeps < 1 || o.max_substeps > 64)
+    fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
+  if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))
+    fail("options.substep_reach", "must be > 0 and finite (got " + fmt(o.substep_reach) + ")");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   mag::DynamicsOptions d = o.magnetics;
   d.method = o.method;
@@ -96,6 +104,9 @@ void check_moment(const std::string& where, int k, const MomentDesc& m) {
   if (!finite(m.offset)) fail(w + ".offset", "must be finite (got " + fmt(m.offset) + ")");
   if (!(m.volume > 0 && std::isfinite(m.volume)))
     fail(w + ".volume", "must be > 0 and finite (got " + fmt(m.volume) + ")");
+  if (!std::isfinite(m.interaction_radius))
+    fail(w + ".interaction_radius", "must be finite: >= 0 (m), or < 0 for auto (got " +
+                                        fmt(m.interaction_radius) + ")");
   if (m.permanent) {
     if (!finite(m.moment)) fail(w + ".moment", "must be finite (got " + fmt(m.moment) + ")");
   } else if (!(m.Ms > 0 && std::isfinite(m.Ms))) {
@@ -175,6 +186,32 @@ double shape_bounding_radius(ShapeKind kind, const Vec3& size) {
     case ShapeKind::Cylinder: return std::hypot(size.x(), size.y());
   }
   return 0.0;
+}
+
+// The radius of the largest sphere about point o (body frame) inside one of the shapes,
+// 0 when no shape holds o: a ball's centre gets its radius, a box's centre its smallest
+// half extent, a point on a capsule's axis its radius.
+static double inscribed_radius(const std::vector<ShapeDesc>& shapes, const Vec3& o) {
+  double best = 0.0;
+  for (const ShapeDesc& s : shapes) {
+    const Vec3 p = s.rotation.normalized().conjugate() * (o - s.offset);  // in the shape's axes
+    const Vec3& z = s.size;
+    double d = 0.0;
+    switch (s.kind) {
+      case ShapeKind::Sphere: d = z.x() - p.norm(); break;
+      case ShapeKind::Box: d = (z - p.cwiseAbs()).minCoeff(); break;
+      case ShapeKind::Capsule: {
+        const double t = std::clamp(p.z(), -z.y(), z.y());
+        d = z.x() - (p - Vec3(0, 0, t)).norm();
+        break;
+      }
+      case ShapeKind::Cylinder:
+        d = std::min(z.x() - p.head<2>().norm(), z.y() - std::abs(p.z()));
+        break;
+    }
+    best = std::max(best, d);
+  }
+  return best;
 }
 
 Model compile_model(const SceneDesc& scene) {
@@ -269,6 +306,8 @@ Model compile_model(const SceneDesc& scene) {
       m.moment_Ms.push_back(md.permanent ? 0.0 : md.Ms);
       m.moment_m.push_back(md.permanent ? md.moment : Vec3::Zero());
       m.moment_radius.push_back(std::cbrt(3.0 * md.volume / (4.0 * kPi)));
+      m.moment_interaction_radius.push_back(
+          md.interaction_radius >= 0 ? md.interaction_radius : inscribed_radius(b.shapes, md.offset));
       if (!md.permanent) ++m.induced_count;
       if (b.type == BodyType::Dynamic) m.dynamic_moments = true;
       ++m.nmoment;
@@ -287,6 +326,12 @@ Model compile_model(const SceneDesc& scene) {
       rmin = s == 0 ? r : std::min(rmin, r);
     }
     m.contact_margin = 0.25 * rmin;
+  }
+  for (int s = 0; s < m.nshape; ++s) {
+    if (m.body_type[m.shape_body[s]] != BodyType::Dynamic) continue;
+    const Vec3& z = m.shape_size[s];
+    const double r = m.shape_kind[s] == ShapeKind::Box ? z.minCoeff() : z.x();
+    m.min_dynamic_radius = m.min_dynamic_radius == 0.0 ? r : std::min(m.min_dynamic_radius, r);
   }
   return m;
 }

@@ -70,9 +70,15 @@ struct Model {
   std::vector<double> moment_Ms;             ///< (nmoment) A/m (induced)
   std::vector<Vec3> moment_m;                ///< (nmoment) body-frame moment, A·m² (permanent)
   std::vector<double> moment_radius;         ///< (nmoment) (3V/4π)^{1/3}, for arrows (m)
+  /// (nmoment) interaction radius of the bounded pairs (m), MomentDesc::interaction_radius
+  /// resolved
+  std::vector<double> moment_interaction_radius;
 
   // derived
   double contact_margin = 0.0;      ///< resolved SimOptions::contact_margin (m), ≥ 0
+  /// smallest inscribed radius of a dynamic body's shapes (m): the length the sub-step
+  /// criterion measures motion in (SimOptions::max_substeps); 0 without dynamic shapes
+  double min_dynamic_radius = 0.0;
   std::vector<int> dynamic_bodies;  ///< indices of the dynamic bodies, ascending
   int induced_count = 0;
   bool dynamic_moments = false;  ///< some moment sits on a dynamic body (forces are needed)

@@ -49,15 +49,17 @@ class OdeBridge {
   void set_velocity(int body, const Vec3& v);
 
   /// Grows each dynamic body's collision geoms by the contact margin plus the distance it
-  /// can cover this step under its velocity, magnetic force (N, per body) and gravity.
-  void update_margins(const State& s, const std::vector<Vec3>& magnetic_force);
-  /// Broad + narrow phase, contacts sorted into a fixed order, contact joints created.
+  /// can cover in a step of h seconds under its velocity, magnetic force (N, per body) and
+  /// gravity.
+  void update_margins(const State& s, const std::vector<Vec3>& magnetic_force, double h);
+  /// Broad + narrow phase, contacts sorted into a fixed order, contact joints created for a
+  /// step of h seconds (speculative contacts close their gap within h).
   /// Writes the touching body pairs (a < b, −1 = ground) to *pairs; returns the number of
   /// contact joints.
-  int collide(std::vector<std::pair<int, int>>* pairs);
-  /// dWorldQuickStep over Δt_r (ODE's constraint-order RNG seeded from `step_index`), then
-  /// empties the contact group.
-  void quickstep(long step_index);
+  int collide(std::vector<std::pair<int, int>>* pairs, double h);
+  /// dWorldQuickStep over h (Δt_r or a sub-step of it; ODE's constraint-order RNG seeded
+  /// from `seed`), then empties the contact group. Damping rates are kept per second.
+  void quickstep(unsigned long seed, double h);
   /// Drops contact joints created by collide() but not yet stepped (after a failed step).
   void discard_contacts();
   /// True after ODE failed inside quickstep(): its world is left half-stepped and must not

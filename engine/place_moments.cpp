@@ -12,6 +12,7 @@ mag::MomentSet make_moment_set(const Model& m) {
       set.add_permanent(Vec3::Zero(), m.moment_volume[j], m.moment_m[j], b);
     else
       set.add_induced(Vec3::Zero(), m.moment_volume[j], m.moment_Ms[j], b);
+    set.radius[j] = m.moment_interaction_radius[j];
   }
   set.H0 = m.H0;
   return set;

@@ -28,7 +28,8 @@ struct StepProfile {
   bool cap_hit = false;      ///< the iteration cap was reached without convergence
   double last_change = 0.0;  ///< max_j |ΔM_j|/Ms_j of the last sweep (Exact: residual)
 
-  int contacts = 0;  ///< contact joints created this step
+  int contacts = 0;  ///< contact joints created this step (its last sub-step)
+  int substeps = 1;  ///< rigid sub-steps the frame was split into (SimOptions::max_substeps)
 };
 
 /// Adds the wall time of its scope (ms) to *out. steady_clock, so immune to clock jumps.

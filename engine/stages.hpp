@@ -23,6 +23,10 @@ void place_moments(const Model& model, const State& s, mag::MomentSet* set);
 void load_magnetization(const State& s, mag::MomentSet* set);
 void store_magnetization(const mag::MomentSet& set, State* s);
 
+// (1b) substeps.cpp
+/// The number of rigid sub-steps for the frame starting at s (SimOptions::max_substeps).
+int choose_substeps(const Model& model, const State& s);
+
 // (2) magnetize.cpp
 /// Relaxes the induced magnetizations (warm-started from `set`) with the model's method,
 /// or solves them exactly for Method::Exact. Fills iterations/converged/cap_hit.

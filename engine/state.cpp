@@ -12,6 +12,7 @@ State initial_state(const Model& m) {
   s.quat = m.body_quat0;
   s.vel = m.body_vel0;
   s.angvel = m.body_angvel0;
+  s.dvel.assign(m.nbody, Vec3::Zero());
   s.enabled.assign(m.nbody, 1);
   s.M1.assign(m.nmoment, Vec3::Zero());
   s.M2.assign(m.nmoment, Vec3::Zero());
@@ -67,6 +68,10 @@ void check_state_shape(const Model& m, const State& s) {
   if (s.M1.size() != nm || s.M2.size() != nm || s.M.size() != nm || s.seeded.size() != nm)
     throw std::invalid_argument("State does not fit the model: expected " + std::to_string(nm) +
                                 " moments, got " + std::to_string(s.M.size()));
+  if (!s.dvel.empty() && s.dvel.size() != nb)
+    throw std::invalid_argument("State does not fit the model: dvel has " +
+                                std::to_string(s.dvel.size()) + " entries, expected " +
+                                std::to_string(nb) + " (or none)");
   if (s.step < 0) throw std::invalid_argument("State step count is negative");
 }
 

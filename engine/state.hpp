@@ -29,6 +29,10 @@ struct State {
   /// Body pairs (a < b) in contact during the last step, −1 = the ground plane. Derived
   /// data kept for metrics (attachment graph); not part of the hash.
   std::vector<std::pair<int, int>> contact_pairs;
+  /// (nbody) m/s: each body's velocity change over the last step, which sets the next
+  /// step's number of rigid sub-steps (SimOptions::max_substeps). Derived data kept so that
+  /// a restored state continues as the original; not part of the hash. Empty = zero.
+  std::vector<Vec3> dvel;
 };
 
 /// The state at t = 0: the scene's poses and velocities, unmagnetized induced moments.

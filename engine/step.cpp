@@ -1,6 +1,8 @@
 // engine/step.cpp — one rigid step, the paper's Algorithm 1 as a table of contents.
 //
 //   (1) moments take their world poses from their bodies     place_moments.cpp
+//   (1b) the frame splits into n rigid sub-steps              substeps.cpp
+//   per sub-step of Δt_r/n:
 //   (2) magnetization dynamics until converged or capped      magnetize.cpp
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
@@ -39,38 +41,52 @@ void Simulation::step() {
       place_moments(m, state_, &moments_);
     }
 
-    // (2) magnetization dynamics on the Δt_m clock, warm-started from the last step
-    {
-      ScopedTimer t(&prof.T_i);
-      magnetize(m, &moments_, &ws_, &prof);
-    }
-    check_magnetization(m, moments_, n);
-
-    // (3) forces (eq. 4 or eqs. 13–14) and torques on the dynamic bodies
-    if (m.dynamic_moments) {
-      ScopedTimer t(&prof.T_f);
-      compute_magnetic_forces(m, moments_, &ws_);
-      check_forces(m, ws_, n);
-      apply_magnetic_forces(m, moments_, &ws_, ode_.get());
-    }
-
-    // (4) collide and step the rigid bodies
-    {
-      ScopedTimer t(&prof.T_r);
-      {
-        ScopedTimer c(&prof.collide_ms);
-        ode_->update_margins(state_, ws_.body_force);
-        prof.contacts = ode_->collide(&ws_.next.contact_pairs);
-      }
-      ScopedTimer q(&prof.quickstep_ms);
-      try {
-        ode_->quickstep(n);
-      } catch (const OdeFailure& e) {
-        // name the body that went bad when there is one, else report ODE's own words
+    // (1b) the frame's rigid sub-steps (1 unless the scene allows more and bodies move fast)
+    const int nsub = choose_substeps(m, state_);
+    const double h = m.options.dt / nsub;
+    prof.substeps = nsub;
+    for (int k = 0; k < nsub; ++k) {
+      if (k > 0) {  // later sub-steps: the moments follow the bodies ODE has moved
+        ScopedTimer t(&prof.sync_ms);
         ode_->read_state(&ws_.next);
-        check_bodies(m, ws_.next, n);
-        throw SimulationError(n, -1, "", "rigid step",
-                              "step " + std::to_string(n) + ": rigid step failed: " + e.what());
+        place_moments(m, ws_.next, &moments_);
+      }
+      const State& now = k == 0 ? state_ : ws_.next;
+
+      // (2) magnetization dynamics on the Δt_m clock, warm-started from the last (sub-)step
+      {
+        ScopedTimer t(&prof.T_i);
+        magnetize(m, &moments_, &ws_, &prof);
+      }
+      check_magnetization(m, moments_, n);
+
+      // (3) forces (eq. 4 or eqs. 13–14) and torques on the dynamic bodies
+      if (m.dynamic_moments) {
+        ScopedTimer t(&prof.T_f);
+        compute_magnetic_forces(m, moments_, &ws_);
+        check_forces(m, ws_, n);
+        apply_magnetic_forces(m, moments_, &ws_, ode_.get());
+      }
+
+      // (4) collide and step the rigid bodies over h
+      {
+        ScopedTimer t(&prof.T_r);
+        {
+          ScopedTimer c(&prof.collide_ms);
+          ode_->update_margins(now, ws_.body_force, h);
+          prof.contacts = ode_->collide(&ws_.next.contact_pairs, h);
+        }
+        ScopedTimer q(&prof.quickstep_ms);
+        try {
+          // the first sub-step keeps the seed of an unsplit step
+          ode_->quickstep(static_cast<unsigned long>(n) ^ (static_cast<unsigned long>(k) << 40), h);
+        } catch (const OdeFailure& e) {
+          // name the body that went bad when there is one, else report ODE's own words
+          ode_->read_state(&ws_.next);
+          check_bodies(m, ws_.next, n);
+          throw SimulationError(n, -1, "", "rigid step",
+                                "step " + std::to_string(n) + ": rigid step failed: " + e.what());
+        }
       }
     }
 
@@ -82,6 +98,8 @@ void Simulation::step() {
       store_magnetization(moments_, &next);
       next.step = n;
       check_bodies(m, next, n);
+      next.dvel.resize(m.nbody);
+      for (int b = 0; b < m.nbody; ++b) next.dvel[b] = next.vel[b] - state_.vel[b];
       std::swap(state_, next);
       place_moments(m, state_, &moments_);  // moments() follows the new poses
     }

@@ -179,7 +179,7 @@ struct CellBufferF {
 
 // Near sources gathered for one group: whole leaves copied from the tree-ordered arrays.
 struct NearBuffer {
-  std::vector<double> a[8];  // x, y, z, mx, my, mz, id, grp (grown, never shrunk)
+  std::vector<double> a[9];  // x, y, z, mx, my, mz, id, grp, rad (grown, never shrunk)
   std::size_t n = 0;
   void clear() { n = 0; }
   void reserve(std::size_t m) {
@@ -188,8 +188,9 @@ struct NearBuffer {
   }
   void append(const detail::SourceBuffer& s, int s0, int s1) {
     reserve(n + (s1 - s0) + detail::kSourcePad);
-    const std::vector<double>* src[8] = {&s.x, &s.y, &s.z, &s.mx, &s.my, &s.mz, &s.id, &s.grp};
-    for (int k = 0; k < 8; ++k) std::copy(src[k]->begin() + s0, src[k]->begin() + s1, a[k].begin() + n);
+    const std::vector<double>* src[9] = {&s.x,  &s.y,  &s.z,   &s.mx, &s.my,
+                                         &s.mz, &s.id, &s.grp, &s.rad};
+    for (int k = 0; k < 9; ++k) std::copy(src[k]->begin() + s0, src[k]->begin() + s1, a[k].begin() + n);
     n += s1 - s0;
   }
   void pad() {
@@ -198,12 +199,15 @@ struct NearBuffer {
       for (int k = 0; k < 3; ++k) a[k][n] = detail::kPadPosition;
       for (int k = 3; k < 6; ++k) a[k][n] = 0.0;
       a[6][n] = a[7][n] = -1.0;
+      a[8][n] = 0.0;
       ++n;
     }
   }
-  detail::SourceView view() const {
+  // bounded: pass the radii (bounded pairs), else unbounded point dipoles
+  detail::SourceView view(bool bounded) const {
     return detail::SourceView{a[0].data(), a[1].data(), a[2].data(), a[3].data(),
-                              a[4].data(), a[5].data(), a[6].data(), a[7].data(), n};
+                              a[4].data(), a[5].data(), a[6].data(), a[7].data(), n,
+                              bounded ? a[8].data() : nullptr};
   }
 };
 
@@ -213,6 +217,7 @@ struct NearBuffer {
 struct NearBufferF {
   std::vector<float> a[6];        // x, y, z (relative to the centre), mx, my, mz
   std::vector<std::int32_t> id, grp;
+  std::vector<float> rad;         // interaction radii (m)
   std::size_t n = 0;
   void clear() { n = 0; }
   void reserve(std::size_t m) {
@@ -221,12 +226,13 @@ struct NearBufferF {
     for (auto& v : a) v.resize(sz);
     id.resize(sz);
     grp.resize(sz);
+    rad.resize(sz);
   }
   // sources s0..s1 of s; their moments, ids and groups already in float / int32 (mf, id32,
   // grp32: the workspace's copies, converted once per call / per tree)
   void append(const detail::SourceBuffer& s, const std::vector<float>* mf,
               const std::vector<std::int32_t>& id32, const std::vector<std::int32_t>& grp32,
-              int s0, int s1, const double* c) {
+              const std::vector<float>& radf, int s0, int s1, const double* c) {
     const std::size_t m = static_cast<std::size_t>(s1 - s0);
     reserve(n + m + detail::kSourcePadF);
     const double* src[3] = {s.x.data() + s0, s.y.data() + s0, s.z.data() + s0};
@@ -240,6 +246,7 @@ struct NearBufferF {
       std::memcpy(a[3 + a3].data() + n, mf[a3].data() + s0, m * sizeof(float));
     std::memcpy(id.data() + n, id32.data() + s0, m * sizeof(std::int32_t));
     std::memcpy(grp.data() + n, grp32.data() + s0, m * sizeof(std::int32_t));  // −1: none
+    std::memcpy(rad.data() + n, radf.data() + s0, m * sizeof(float));
     n += m;
   }
   void pad() {
@@ -248,12 +255,14 @@ struct NearBufferF {
       for (int k = 0; k < 3; ++k) a[k][n] = detail::kPadPositionF;
       for (int k = 3; k < 6; ++k) a[k][n] = 0.0f;
       id[n] = grp[n] = -1;
+      rad[n] = 0.0f;
       ++n;
     }
   }
-  detail::SourceViewF view() const {
+  detail::SourceViewF view(bool bounded) const {
     return detail::SourceViewF{a[0].data(), a[1].data(), a[2].data(), a[3].data(),
-                               a[4].data(), a[5].data(), id.data(), grp.data(), n};
+                               a[4].data(), a[5].data(), id.data(),   grp.data(),
+                               n,           bounded ? rad.data() : nullptr};
   }
 };
 
@@ -286,9 +295,11 @@ struct BarnesHutWorkspace {
   std::vector<std::int32_t> key_grp;
   std::vector<std::uint8_t> key_nz, nz;  // moment i nonzero (cached / this call)
   std::vector<double> key_w, w;          // its largest possible |m_i| (cached / this call)
+  std::vector<double> key_rad;           // interaction radii (cached)
   int key_leaf = 0, key_group = 0;
   bool lists_valid[2] = {false, false};  // [want_J]
   double lists_theta[2] = {0, 0};
+  double lists_gap[2] = {0, 0};          // the far cells' minimum gap (bounded pairs)
   std::vector<GroupLists> lists[2];
   std::vector<std::uint8_t> shared;  // moment i belongs to a body of several moments
 
@@ -302,6 +313,7 @@ struct BarnesHutWorkspace {
   detail::SourceBuffer src;  // nonzero sources in tree order (not padded)
   std::vector<double> src_w;  // their largest possible |m_i|
   std::vector<std::int32_t> src_id32, src_grp32;  // their ids and groups (−1: none) as int32
+  std::vector<float> src_radf;                    // their interaction radii in float
   std::vector<float> src_mf[3];                   // their moments in float (this call)
   std::vector<ThreadScratch> threads;
   BarnesHutStats stats;
@@ -591,16 +603,18 @@ void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspac
     const int i = ws->order[t];
     if (!ws->nz[i]) continue;
     const Vec3& p = set.position[i];
-    ws->src.push(p.x(), p.y(), p.z(), 0.0, 0.0, 0.0, i, set.group[i]);
+    ws->src.push(p.x(), p.y(), p.z(), 0.0, 0.0, 0.0, i, set.group[i], set.radius[i]);
     ws->src_w.push_back(ws->w[i]);
   }
   ws->src_prefix[n] = static_cast<int>(ws->src.size());
   const std::size_t ns = ws->src.size();
   ws->src_id32.resize(ns);
   ws->src_grp32.resize(ns);
+  ws->src_radf.resize(ns);
   for (std::size_t k = 0; k < ns; ++k) {
     ws->src_id32[k] = static_cast<std::int32_t>(ws->src.id[k]);
     ws->src_grp32[k] = static_cast<std::int32_t>(ws->src.grp[k]);
+    ws->src_radf[k] = static_cast<float>(ws->src.rad[k]);
   }
 
   ws->nodes.assign(1, Node{});
@@ -684,8 +698,10 @@ double far_scale(const BarnesHutWorkspace& ws, const Group& g, const GroupLists&
 }
 
 // Walks the tree for one target group and fills its interaction lists (see file comment).
-void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, bool want_J,
-                 std::vector<std::pair<int, bool>>* stack, GroupLists* gl) {
+// min_gap: an accepted cell also keeps every source this far from every target (bounded
+// pairs: 2 × the largest interaction radius, so that no far pair would need the bound).
+void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, double min_gap,
+                 bool want_J, std::vector<std::pair<int, bool>>* stack, GroupLists* gl) {
   gl->far_hj.clear();
   gl->far_h.clear();
   gl->far_j.clear();
@@ -702,7 +718,8 @@ void build_lists(const BarnesHutWorkspace& ws, const Group& g, double theta, boo
     const double R = std::sqrt(dx * dx + dy * dy + dz * dz);
     // multipole acceptance: every target of the group sees the cell under an angle < θ;
     // the margin keeps out (despite rounding) a cell holding a target itself (b = 0 at R = b_t)
-    const bool accept = theta > 0 && R * (1.0 - 1e-12) > g.tb + nd.b && nd.b < theta * (R - g.tb);
+    const bool accept = theta > 0 && R * (1.0 - 1e-12) > g.tb + nd.b && nd.b < theta * (R - g.tb) &&
+                        R - g.tb - nd.b >= min_gap;
     const bool overlap = want_J && groups_overlap(nd, g);
     if (accept) {
       if (!want_J) {
@@ -768,7 +785,8 @@ void gather(const BarnesHutWorkspace& ws, const Group& g, const GroupLists& gl, 
   };
   auto leaves_f = [&ws, &g](const std::vector<int>& ids, NearBufferF* nb) {
     for (int id : ids)
-      nb->append(ws.src, ws.src_mf, ws.src_id32, ws.src_grp32, ws.hot[id].s0, ws.hot[id].s1, g.tc);
+      nb->append(ws.src, ws.src_mf, ws.src_id32, ws.src_grp32, ws.src_radf, ws.hot[id].s0,
+                 ws.hot[id].s1, g.tc);
     nb->pad();
   };
   if (near_float) {
@@ -1276,13 +1294,15 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
       ws->key_group == gsize && ws->key_nz == ws->nz &&
       std::memcmp(ws->key_w.data(), ws->w.data(), n * sizeof(double)) == 0 &&
       std::memcmp(ws->key_pos.data(), set.position.data(), n * sizeof(Vec3)) == 0 &&
-      std::memcmp(ws->key_grp.data(), set.group.data(), n * sizeof(std::int32_t)) == 0;
+      std::memcmp(ws->key_grp.data(), set.group.data(), n * sizeof(std::int32_t)) == 0 &&
+      std::memcmp(ws->key_rad.data(), set.radius.data(), n * sizeof(double)) == 0;
   if (!same_tree) {
     ws->tree_valid = false;
     ws->lists_valid[0] = ws->lists_valid[1] = false;
     build_tree(set, opt, ws);
     ws->key_pos = set.position;
     ws->key_grp = set.group;
+    ws->key_rad = set.radius;
     ws->key_nz = ws->nz;
     ws->key_w = ws->w;
     ws->key_leaf = leaf;
@@ -1301,7 +1321,13 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   const bool far_float = near_float && opt.bh_far_float;
   const bool want_J = J != nullptr;
   const int mode = want_J ? 1 : 0;
-  const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.bh_theta;
+  // bounded pairs: near leaves carry the radii; far cells keep 2 a_max of clearance
+  const bool bounded = pairs_bounded(set, opt);
+  double min_gap = 0.0;
+  if (bounded)
+    for (double a : set.radius) min_gap = std::max(min_gap, 2.0 * a);
+  const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.bh_theta ||
+                         ws->lists_gap[mode] != min_gap;
   const int order = opt.bh_order;
   const int nthreads = omp_get_max_threads();
   if (static_cast<int>(ws->threads.size()) < nthreads) ws->threads.resize(nthreads);
@@ -1319,11 +1345,11 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
     for (long l = 0; l < ngroups; ++l) {
       const Group& g = ws->groups[l];
       const auto t_l0 = std::chrono::steady_clock::now();
-      if (new_lists) build_lists(*ws, g, opt.bh_theta, want_J, &th.stack, &lists[l]);
+      if (new_lists) build_lists(*ws, g, opt.bh_theta, min_gap, want_J, &th.stack, &lists[l]);
       th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
       gather(*ws, g, lists[l], near_float, far_float, &th);
-      const detail::SourceView vn = th.near.view(), vj = th.near_j.view();
-      const detail::SourceViewF vnf = th.nearf.view(), vjf = th.nearf_j.view();
+      const detail::SourceView vn = th.near.view(bounded), vj = th.near_j.view(bounded);
+      const detail::SourceViewF vnf = th.nearf.view(bounded), vjf = th.nearf_j.view(bounded);
       const long nt = g.t1 - g.t0;
       th.near_pairs += nt * static_cast<long>(vn.n + vj.n + vnf.n + vjf.n);
       th.far_cells += nt * static_cast<long>(th.far_hj.size() + th.far_h.size() + th.far_j.size() +
@@ -1338,7 +1364,7 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
         const Vec3& p = set.position[i];
         const double grp = set.group[i] >= 0 ? static_cast<double>(set.group[i])
                                              : std::numeric_limits<double>::quiet_NaN();
-        const detail::Target tg{p.x(), p.y(), p.z(), static_cast<double>(i), grp};
+        const detail::Target tg{p.x(), p.y(), p.z(), static_cast<double>(i), grp, set.radius[i]};
         const double pp[3] = {p.x(), p.y(), p.z()};
         double h[3] = {0, 0, 0}, jac[6] = {0, 0, 0, 0, 0, 0}, unused[3] = {0, 0, 0};
         const detail::PairTerms terms = want_J ? detail::PairTerms::HJ : detail::PairTerms::H;
@@ -1347,7 +1373,8 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
           const detail::TargetF tf{static_cast<float>(p.x() - g.tc[0]),
                                    static_cast<float>(p.y() - g.tc[1]),
                                    static_cast<float>(p.z() - g.tc[2]), static_cast<std::int32_t>(i),
-                                   set.group[i] >= 0 ? set.group[i] : detail::kNoGroupF};
+                                   set.group[i] >= 0 ? set.group[i] : detail::kNoGroupF,
+                                   static_cast<float>(set.radius[i])};
           detail::sum_pairs_f32(vnf, tf, eps2f, terms, h, jac);
           if (want_J) detail::sum_pairs_f32(vjf, tf, eps2f, detail::PairTerms::HJ, unused, jac);
         } else {
@@ -1382,6 +1409,7 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   }
   ws->lists_valid[mode] = true;
   ws->lists_theta[mode] = opt.bh_theta;
+  ws->lists_gap[mode] = min_gap;
   const auto t_end = std::chrono::steady_clock::now();
   BarnesHutStats& st = ws->stats;
   st.nodes = static_cast<int>(ws->nodes.size());

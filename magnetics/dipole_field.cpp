@@ -43,6 +43,12 @@ Mat3 dipole_jacobian(const Vec3& r, const Vec3& m, double eps2) {
   return kInv4Pi * J;
 }
 
+// bounded pairs: r → r·R/|r| when |r| < R (|r| = 0 stays 0)
+Vec3 bounded_separation(const Vec3& r, double R) {
+  const double d = r.norm();
+  return d < R && d > 0 ? Vec3(r * (R / d)) : r;
+}
+
 const char* field_solver_name(FieldSolver s) {
   switch (s) {
     case FieldSolver::Direct: return "direct";
@@ -75,6 +81,13 @@ std::string validate(const FieldOptions& o) {
   return e.str();
 }
 
+bool pairs_bounded(const MomentSet& set, const FieldOptions& opt) {
+  if (!opt.bounded_pairs) return false;
+  for (double a : set.radius)
+    if (a > 0) return true;
+  return false;
+}
+
 FieldSolver resolve_solver(const FieldOptions& opt, std::size_t n) {
   if (opt.solver != FieldSolver::Auto) return opt.solver;
   return n >= static_cast<std::size_t>(opt.auto_threshold) ? FieldSolver::BarnesHut
@@ -84,7 +97,7 @@ FieldSolver resolve_solver(const FieldOptions& opt, std::size_t n) {
 // scratch: a copy starts with the packed arrays but builds its own tree
 FieldWorkspace::FieldWorkspace(const FieldWorkspace& o)
     : sx(o.sx), sy(o.sy), sz(o.sz), smx(o.smx), smy(o.smy), smz(o.smz), sid(o.sid),
-      sgrp(o.sgrp) {}
+      sgrp(o.sgrp), srad(o.srad), bounded(o.bounded) {}
 FieldWorkspace& FieldWorkspace::operator=(const FieldWorkspace& o) {
   if (this != &o) {
     FieldWorkspace t(o);
@@ -97,19 +110,22 @@ namespace detail {
 
 void SourceBuffer::clear() {
   x.clear(); y.clear(); z.clear(); mx.clear(); my.clear(); mz.clear(); id.clear(); grp.clear();
+  rad.clear();
 }
 
 void SourceBuffer::push(double px, double py, double pz, double qx, double qy, double qz,
-                        double index, double group) {
+                        double index, double group, double radius) {
   x.push_back(px); y.push_back(py); z.push_back(pz);
   mx.push_back(qx); my.push_back(qy); mz.push_back(qz);
   id.push_back(index); grp.push_back(group < 0 ? -1.0 : group);
+  rad.push_back(radius);
 }
 
 namespace {
 
 // Portable sweep (any CPU): the same sums as the AVX-512 one, `omp simd` vectorized.
-template <bool kJac>
+// kBound: bounded pairs (field_kernel.hpp, sum_pairs).
+template <bool kJac, bool kBound>
 void sum_pairs_portable(const SourceView& v, const Target& t, double eps2, double* Hout,
                         double* Jout) {
   const double* __restrict sx = v.x;
@@ -120,14 +136,23 @@ void sum_pairs_portable(const SourceView& v, const Target& t, double eps2, doubl
   const double* __restrict mz = v.mz;
   const double* __restrict si = v.id;
   const double* __restrict sg = v.grp;
-  const double px = t.x, py = t.y, pz = t.z, self = t.id, grp = t.grp;
+  const double* __restrict sr = v.rad;
+  const double px = t.x, py = t.y, pz = t.z, self = t.id, grp = t.grp, trad = t.rad;
   double ax = 0, ay = 0, az = 0, bx = 0, by = 0, bz = 0;
   double ja = 0, jxx = 0, jyy = 0, jzz = 0, jxy = 0, jxz = 0, jyz = 0;
 #pragma omp simd reduction(+ : ax, ay, az, bx, by, bz, ja, jxx, jyy, jzz, jxy, jxz, jyz)
   for (std::size_t i = 0; i < v.n; ++i) {
-    const double dx = px - sx[i], dy = py - sy[i], dz = pz - sz[i];
+    double dx = px - sx[i], dy = py - sy[i], dz = pz - sz[i];
     const bool is_self = si[i] == self;
-    const double q = is_self ? 1.0 : dx * dx + dy * dy + dz * dz + eps2;
+    double r2 = dx * dx + dy * dy + dz * dz;
+    if constexpr (kBound) {
+      // |r| < R = a_i + a_t: evaluate at r·R/|r| (|r| = 0 keeps r = 0: then only −m/R³)
+      const double R = sr[i] + trad;
+      const double s = r2 < R * R ? R / std::sqrt(std::max(r2, 1e-300)) : 1.0;
+      dx *= s; dy *= s; dz *= s;
+      r2 = std::max(r2, R * R);
+    }
+    const double q = is_self ? 1.0 : r2 + eps2;
     const double inv = is_self ? 0.0 : 1.0 / std::sqrt(q);
     const double inv2 = inv * inv;
     const double inv3 = inv2 * inv;
@@ -181,26 +206,46 @@ MAGSIM_TARGET_AVX512 inline double hsum(__m512d v) {
 }
 
 // The sweep over eight sources at a time; the same algebra as sum_pairs_portable.
-template <bool kJac>
+template <bool kJac, bool kBound>
 MAGSIM_TARGET_AVX512 void sum_pairs_avx512(const SourceView& v, const Target& t, double eps2,
                                            double* Hout, double* Jout) {
   const __m512d px = _mm512_set1_pd(t.x), py = _mm512_set1_pd(t.y), pz = _mm512_set1_pd(t.z);
   const __m512d self = _mm512_set1_pd(t.id), grp = _mm512_set1_pd(t.grp);
   const __m512d e2 = _mm512_set1_pd(eps2);
   const __m512d five = _mm512_set1_pd(5.0);
+  const __m512d trad = _mm512_set1_pd(t.rad);
   __m512d ax = _mm512_setzero_pd(), ay = ax, az = ax, bx = ax, by = ax, bz = ax;
   __m512d ja = ax, jxx = ax, jyy = ax, jzz = ax, jxy = ax, jxz = ax, jyz = ax;
   for (std::size_t i = 0; i < v.n; i += 8) {
-    const __m512d dx = _mm512_sub_pd(px, _mm512_loadu_pd(v.x + i));
-    const __m512d dy = _mm512_sub_pd(py, _mm512_loadu_pd(v.y + i));
-    const __m512d dz = _mm512_sub_pd(pz, _mm512_loadu_pd(v.z + i));
+    __m512d dx = _mm512_sub_pd(px, _mm512_loadu_pd(v.x + i));
+    __m512d dy = _mm512_sub_pd(py, _mm512_loadu_pd(v.y + i));
+    __m512d dz = _mm512_sub_pd(pz, _mm512_loadu_pd(v.z + i));
     const __m512d mx = _mm512_loadu_pd(v.mx + i);
     const __m512d my = _mm512_loadu_pd(v.my + i);
     const __m512d mz = _mm512_loadu_pd(v.mz + i);
-    __m512d q = _mm512_fmadd_pd(dx, dx, e2);
-    q = _mm512_fmadd_pd(dy, dy, q);
-    q = _mm512_fmadd_pd(dz, dz, q);
     const __mmask8 other = _mm512_cmp_pd_mask(_mm512_loadu_pd(v.id + i), self, _CMP_NEQ_UQ);
+    __m512d q;
+    if constexpr (kBound) {
+      // |r| < R = a_i + a_t: evaluate at r·R/|r| (rare: only touching pairs take the branch)
+      const __m512d R = _mm512_add_pd(_mm512_loadu_pd(v.rad + i), trad);
+      const __m512d R2 = _mm512_mul_pd(R, R);
+      __m512d r2 = _mm512_mul_pd(dx, dx);
+      r2 = _mm512_fmadd_pd(dy, dy, r2);
+      r2 = _mm512_fmadd_pd(dz, dz, r2);
+      const __mmask8 in = _mm512_cmp_pd_mask(r2, R2, _CMP_LT_OQ) & other;
+      if (in) {
+        const __m512d d = _mm512_maskz_sqrt_pd(in, _mm512_maskz_max_pd(0xff, r2, _mm512_set1_pd(1e-300)));
+        const __m512d s = _mm512_maskz_div_pd(in, R, d);
+        dx = _mm512_mask_mul_pd(dx, in, dx, s);
+        dy = _mm512_mask_mul_pd(dy, in, dy, s);
+        dz = _mm512_mask_mul_pd(dz, in, dz, s);
+      }
+      q = _mm512_add_pd(_mm512_maskz_max_pd(0xff, r2, R2), e2);
+    } else {
+      q = _mm512_fmadd_pd(dx, dx, e2);
+      q = _mm512_fmadd_pd(dy, dy, q);
+      q = _mm512_fmadd_pd(dz, dz, q);
+    }
     const __m512d inv = rsqrt_pd(other, q);
     const __m512d inv2 = _mm512_mul_pd(inv, inv);
     const __m512d inv3 = _mm512_mul_pd(inv2, inv);
@@ -275,14 +320,27 @@ bool simd_kernel_active() {
 void sum_pairs(const SourceView& v, const Target& t, double eps2, PairTerms terms, double* H,
                double* J) {
 #ifdef MAGSIM_AVX512_KERNEL
+  const bool bound = v.rad != nullptr;
   if (simd_kernel_active()) {
-    if (terms == PairTerms::HJ) sum_pairs_avx512<true>(v, t, eps2, H, J);
-    else sum_pairs_avx512<false>(v, t, eps2, H, J);
+    if (terms == PairTerms::HJ) {
+      if (bound) sum_pairs_avx512<true, true>(v, t, eps2, H, J);
+      else sum_pairs_avx512<true, false>(v, t, eps2, H, J);
+    } else {
+      if (bound) sum_pairs_avx512<false, true>(v, t, eps2, H, J);
+      else sum_pairs_avx512<false, false>(v, t, eps2, H, J);
+    }
     return;
   }
+#else
+  const bool bound = v.rad != nullptr;
 #endif
-  if (terms == PairTerms::HJ) sum_pairs_portable<true>(v, t, eps2, H, J);
-  else sum_pairs_portable<false>(v, t, eps2, H, J);
+  if (terms == PairTerms::HJ) {
+    if (bound) sum_pairs_portable<true, true>(v, t, eps2, H, J);
+    else sum_pairs_portable<true, false>(v, t, eps2, H, J);
+  } else {
+    if (bound) sum_pairs_portable<false, true>(v, t, eps2, H, J);
+    else sum_pairs_portable<false, false>(v, t, eps2, H, J);
+  }
 }
 
 }  // namespace detail
@@ -295,35 +353,38 @@ constexpr std::size_t kChunk = 4096;
 // Targets per block (the unit of work of a thread).
 constexpr long kTargetBlock = 32;
 
-void pack_sources(const MomentSet& set, FieldWorkspace* ws) {
+void pack_sources(const MomentSet& set, const FieldOptions& opt, FieldWorkspace* ws) {
   std::vector<double>* a[] = {&ws->sx, &ws->sy, &ws->sz, &ws->smx, &ws->smy, &ws->smz,
-                              &ws->sid, &ws->sgrp};
+                              &ws->sid, &ws->sgrp, &ws->srad};
   for (auto* v : a) v->clear();
-  auto push = [&](const Vec3& p, const Vec3& m, double id, double grp) {
+  auto push = [&](const Vec3& p, const Vec3& m, double id, double grp, double rad) {
     ws->sx.push_back(p.x()); ws->sy.push_back(p.y()); ws->sz.push_back(p.z());
     ws->smx.push_back(m.x()); ws->smy.push_back(m.y()); ws->smz.push_back(m.z());
     ws->sid.push_back(id); ws->sgrp.push_back(grp < 0 ? -1.0 : grp);
+    ws->srad.push_back(rad);
   };
   for (std::size_t i = 0; i < set.size(); ++i) {
     const Vec3 m = set.moment(i);
     if (m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0) continue;
-    push(set.position[i], m, static_cast<double>(i), set.group[i]);
+    push(set.position[i], m, static_cast<double>(i), set.group[i], set.radius[i]);
   }
   const Vec3 far = Vec3::Constant(detail::kPadPosition);
-  while (ws->sx.size() % detail::kSourcePad != 0) push(far, Vec3::Zero(), -1.0, -1.0);
+  while (ws->sx.size() % detail::kSourcePad != 0) push(far, Vec3::Zero(), -1.0, -1.0, 0.0);
+  ws->bounded = pairs_bounded(set, opt);
 }
 
 detail::SourceView packed_view(const FieldWorkspace& ws, std::size_t b, std::size_t e) {
   return detail::SourceView{ws.sx.data() + b,  ws.sy.data() + b,  ws.sz.data() + b,
                             ws.smx.data() + b, ws.smy.data() + b, ws.smz.data() + b,
-                            ws.sid.data() + b, ws.sgrp.data() + b, e - b};
+                            ws.sid.data() + b, ws.sgrp.data() + b, e - b,
+                            ws.bounded ? ws.srad.data() + b : nullptr};
 }
 
 detail::Target target_of(const MomentSet& set, std::size_t j) {
   const Vec3& p = set.position[j];
   const double g = set.group[j] >= 0 ? static_cast<double>(set.group[j])
                                      : std::numeric_limits<double>::quiet_NaN();
-  return detail::Target{p.x(), p.y(), p.z(), static_cast<double>(j), g};
+  return detail::Target{p.x(), p.y(), p.z(), static_cast<double>(j), g, set.radius[j]};
 }
 
 // The direct sum at targets idx[0..nt) (or 0..nt when idx is null), H0 added.
@@ -369,7 +430,7 @@ void compute_fields(const MomentSet& set, const FieldOptions& opt, std::vector<V
     barnes_hut_fields(set, opt, H, J, ws->bh.get());
     return;
   }
-  pack_sources(set, ws);
+  pack_sources(set, opt, ws);
   direct_sum(set, opt, *ws, nullptr, n, H->data(), J ? J->data() : nullptr);
 }
 
@@ -379,7 +440,7 @@ void compute_fields_at(const MomentSet& set, const FieldOptions& opt,
   const long nt = static_cast<long>(targets.size());
   H->resize(nt);
   if (J) J->resize(nt);
-  pack_sources(set, ws);
+  pack_sources(set, opt, ws);
   direct_sum(set, opt, *ws, targets.data(), nt, H->data(), J ? J->data() : nullptr);
 }
 

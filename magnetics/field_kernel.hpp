@@ -36,17 +36,20 @@ struct SourceBuffer {
   std::vector<double> mx, my, mz;  ///< (ns) moment (A·m²)
   std::vector<double> id;          ///< (ns) moment index (−1 for padding), for self-exclusion
   std::vector<double> grp;         ///< (ns) group id (negative groups stored as −1)
+  std::vector<double> rad;         ///< (ns) interaction radius (m), 0 = a point
 
   std::size_t size() const { return x.size(); }
   void clear();
   void push(double px, double py, double pz, double qx, double qy, double qz, double index,
-            double group);
+            double group, double radius = 0.0);
 };
 
 /// A read-only view of padded source arrays (as FieldWorkspace's or a gathered copy).
 struct SourceView {
   const double *x, *y, *z, *mx, *my, *mz, *id, *grp;
   std::size_t n;  ///< a multiple of kSourcePad
+  /// interaction radii a_i (m); nullptr = unbounded point dipoles (see sum_pairs)
+  const double* rad;
 };
 
 /// A target point: its own moment index (−1: none) and group for the exclusions.
@@ -54,6 +57,7 @@ struct Target {
   double x, y, z;
   double id;   ///< moment index; a source with the same id is skipped (self)
   double grp;  ///< group id as a double, NaN when the target has no group (< 0)
+  double rad;  ///< its interaction radius a_t (m), used with SourceView::rad
 };
 
 /// What a pair sum adds.
@@ -63,6 +67,14 @@ enum class PairTerms { H, HJ };
 /// PairTerms::HJ to J[0..5] (xx, yy, zz, xy, xz, yz) the Jacobian of those not in t's group.
 /// Softened with eps2 = ε². Results in A/m (A/m²). Dispatches to AVX-512 where the CPU has
 /// it, else a portable loop; the sum order is fixed, so results are deterministic.
+///
+/// Bounded pairs (v.rad != nullptr): a pair closer than R = a_i + a_t is evaluated at the
+/// separation R along its own direction, r → r·R/|r| (field and Jacobian alike), so an
+/// overlap cannot raise the pair's field or force above their values at contact; pairs at
+/// |r| ≥ R are exact. The Jacobian there is the dipole Jacobian at the clamped point, not
+/// the derivative of the clamped field (which has no radial part): the force stays
+/// continuous through |r| = R and bounded, at the price of not being a gradient inside an
+/// overlap. Softening then applies to the clamped separation.
 void sum_pairs(const SourceView& v, const Target& t, double eps2, PairTerms terms, double* H,
                double* J);
 
@@ -85,6 +97,7 @@ struct SourceViewF {
   const float *x, *y, *z, *mx, *my, *mz;
   const std::int32_t *id, *grp;
   std::size_t n;  ///< a multiple of kSourcePadF
+  const float* rad;  ///< interaction radii (m); nullptr = unbounded (as SourceView::rad)
 };
 
 /// A target relative to the same centre as the sources of its SourceViewF.
@@ -92,9 +105,11 @@ struct TargetF {
   float x, y, z;
   std::int32_t id;   ///< moment index; a source with the same id is skipped (self)
   std::int32_t grp;  ///< group id, kNoGroupF when the target has no group (< 0)
+  float rad;         ///< its interaction radius (m), used with SourceViewF::rad
 };
 
-/// sum_pairs in single precision: the same terms (eq. 1, softened; the Jacobian without the
+/// sum_pairs in single precision: the same terms (eq. 1, softened, bounded pairs as in
+/// sum_pairs; the Jacobian without the
 /// target's group; never the target itself), each source evaluated in float, summed per
 /// lane in float over at most kChunkF sources and then in double (so the rounding of the
 /// sum stays ~1e-7 relative to Σ|terms| however long the list). AVX-512 (16 lanes) when

@@ -45,6 +45,7 @@ int MomentSet::add_induced(const Vec3& p, double V, double Ms_, std::int32_t grp
   kind.push_back(MomentKind::Induced);
   m_perm.push_back(Vec3::Zero());
   group.push_back(grp);
+  radius.push_back(0.0);
   M1.push_back(Vec3::Zero());
   M2.push_back(Vec3::Zero());
   M.push_back(Vec3::Zero());
@@ -59,6 +60,7 @@ int MomentSet::add_permanent(const Vec3& p, double V, const Vec3& m, std::int32_
   kind.push_back(MomentKind::Permanent);
   m_perm.push_back(m);
   group.push_back(grp);
+  radius.push_back(0.0);
   M1.push_back(Vec3::Zero());
   M2.push_back(Vec3::Zero());
   M.push_back(m / V);

@@ -22,6 +22,11 @@ struct MomentSet {
   std::vector<MomentKind> kind;     ///< (n)
   std::vector<Vec3> m_perm;         ///< (n) world-frame permanent moment (A·m²); 0 for induced
   std::vector<std::int32_t> group;  ///< (n) rigid-body id, −1 = a group of its own
+  /// (n) interaction radius a_j (m), from the moment's shape: with FieldOptions::
+  /// bounded_pairs a pair is evaluated at a separation of at least a_i + a_j (field,
+  /// Jacobian and so forces), so an overlap left by the contact solver cannot raise the
+  /// magnetic pull. 0 = a point (never bounded); set by the engine, 0 from add_*.
+  std::vector<double> radius;
   Vec3 H0 = Vec3::Zero();           ///< uniform external field (A/m)
 
   // state (induced moments; permanent moments keep M = m/V and M1 = M2 = 0)

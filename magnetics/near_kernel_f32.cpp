@@ -20,7 +20,7 @@ namespace {
 
 // Portable sweep: the algebra of sum_pairs_portable (dipole_field.cpp) in float, one
 // chunk of sources at a time, chunk sums added in double.
-template <bool kJac>
+template <bool kJac, bool kBound>
 void sum_pairs_f32_portable(const SourceViewF& v, const TargetF& t, float eps2, double* Hout,
                             double* Jout) {
   const float* __restrict sx = v.x;
@@ -31,7 +31,8 @@ void sum_pairs_f32_portable(const SourceViewF& v, const TargetF& t, float eps2, 
   const float* __restrict mz = v.mz;
   const std::int32_t* __restrict si = v.id;
   const std::int32_t* __restrict sg = v.grp;
-  const float px = t.x, py = t.y, pz = t.z;
+  const float* __restrict sr = v.rad;
+  const float px = t.x, py = t.y, pz = t.z, trad = t.rad;
   const std::int32_t self = t.id, grp = t.grp;
   double acc[13] = {};  // ax ay az bx by bz ja jxx jyy jzz jxy jxz jyz
   // float partial sums of kChunkF / 16 sources (as many terms as an AVX-512 lane sums:
@@ -43,9 +44,17 @@ void sum_pairs_f32_portable(const SourceViewF& v, const TargetF& t, float eps2, 
     float ja = 0, jxx = 0, jyy = 0, jzz = 0, jxy = 0, jxz = 0, jyz = 0;
 #pragma omp simd reduction(+ : ax, ay, az, bx, by, bz, ja, jxx, jyy, jzz, jxy, jxz, jyz)
     for (std::size_t i = c; i < e; ++i) {
-      const float dx = px - sx[i], dy = py - sy[i], dz = pz - sz[i];
+      float dx = px - sx[i], dy = py - sy[i], dz = pz - sz[i];
       const bool is_self = si[i] == self;
-      const float q = is_self ? 1.0f : dx * dx + dy * dy + dz * dz + eps2;
+      float r2 = dx * dx + dy * dy + dz * dz;
+      if constexpr (kBound) {
+        // bounded pair (field_kernel.hpp): |r| < R = a_i + a_t is evaluated at r·R/|r|
+        const float R = sr[i] + trad;
+        const float s = r2 < R * R ? R / std::sqrt(std::max(r2, 1e-30f)) : 1.0f;
+        dx *= s; dy *= s; dz *= s;
+        r2 = std::max(r2, R * R);
+      }
+      const float q = is_self ? 1.0f : r2 + eps2;
       const float inv = is_self ? 0.0f : 1.0f / std::sqrt(q);
       const float inv2 = inv * inv;
       const float inv3 = inv2 * inv;
@@ -114,9 +123,10 @@ MAGSIM_TARGET_AVX512 inline double hsum(__m512d v) {
 }
 
 // The sweep over sixteen sources at a time; the algebra of sum_pairs_avx512 (dipole_field.cpp).
-template <bool kJac>
+template <bool kJac, bool kBound>
 MAGSIM_TARGET_AVX512 void sum_pairs_f32_avx512(const SourceViewF& v, const TargetF& t,
                                                float eps2, double* Hout, double* Jout) {
+  const __m512 trad = _mm512_set1_ps(t.rad);
   const __m512 px = _mm512_set1_ps(t.x), py = _mm512_set1_ps(t.y), pz = _mm512_set1_ps(t.z);
   const __m512i self = _mm512_set1_epi32(t.id), grp = _mm512_set1_epi32(t.grp);
   const __m512 e2 = _mm512_set1_ps(eps2);
@@ -129,17 +139,36 @@ MAGSIM_TARGET_AVX512 void sum_pairs_f32_avx512(const SourceViewF& v, const Targe
     __m512 ax = _mm512_setzero_ps(), ay = ax, az = ax, bx = ax, by = ax, bz = ax;
     __m512 ja = ax, jxx = ax, jyy = ax, jzz = ax, jxy = ax, jxz = ax, jyz = ax;
     for (std::size_t i = c; i < end; i += 16) {
-      const __m512 dx = _mm512_sub_ps(px, _mm512_loadu_ps(v.x + i));
-      const __m512 dy = _mm512_sub_ps(py, _mm512_loadu_ps(v.y + i));
-      const __m512 dz = _mm512_sub_ps(pz, _mm512_loadu_ps(v.z + i));
+      __m512 dx = _mm512_sub_ps(px, _mm512_loadu_ps(v.x + i));
+      __m512 dy = _mm512_sub_ps(py, _mm512_loadu_ps(v.y + i));
+      __m512 dz = _mm512_sub_ps(pz, _mm512_loadu_ps(v.z + i));
       const __m512 mx = _mm512_loadu_ps(v.mx + i);
       const __m512 my = _mm512_loadu_ps(v.my + i);
       const __m512 mz = _mm512_loadu_ps(v.mz + i);
-      __m512 q = _mm512_fmadd_ps(dx, dx, e2);
-      q = _mm512_fmadd_ps(dy, dy, q);
-      q = _mm512_fmadd_ps(dz, dz, q);
       const __mmask16 other =
           _mm512_cmpneq_epi32_mask(_mm512_loadu_si512(v.id + i), self);
+      __m512 q;
+      if constexpr (kBound) {
+        // bounded pair: |r| < R = a_i + a_t is evaluated at r·R/|r| (rare branch)
+        const __m512 R = _mm512_add_ps(_mm512_loadu_ps(v.rad + i), trad);
+        const __m512 R2 = _mm512_mul_ps(R, R);
+        __m512 r2 = _mm512_mul_ps(dx, dx);
+        r2 = _mm512_fmadd_ps(dy, dy, r2);
+        r2 = _mm512_fmadd_ps(dz, dz, r2);
+        const __mmask16 in = _mm512_cmp_ps_mask(r2, R2, _CMP_LT_OQ) & other;
+        if (in) {
+          const __m512 d = _mm512_maskz_sqrt_ps(in, _mm512_maskz_max_ps(0xffff, r2, _mm512_set1_ps(1e-30f)));
+          const __m512 s = _mm512_maskz_div_ps(in, R, d);
+          dx = _mm512_mask_mul_ps(dx, in, dx, s);
+          dy = _mm512_mask_mul_ps(dy, in, dy, s);
+          dz = _mm512_mask_mul_ps(dz, in, dz, s);
+        }
+        q = _mm512_add_ps(_mm512_maskz_max_ps(0xffff, r2, R2), e2);
+      } else {
+        q = _mm512_fmadd_ps(dx, dx, e2);
+        q = _mm512_fmadd_ps(dy, dy, q);
+        q = _mm512_fmadd_ps(dz, dz, q);
+      }
       const __m512 inv = rsqrt_ps(other, q);
       const __m512 inv2 = _mm512_mul_ps(inv, inv);
       const __m512 inv3 = _mm512_mul_ps(inv2, inv);
@@ -206,14 +235,27 @@ MAGSIM_TARGET_AVX512 void sum_pairs_f32_avx512(const SourceViewF& v, const Targe
 void sum_pairs_f32(const SourceViewF& v, const TargetF& t, float eps2, PairTerms terms,
                    double* H, double* J) {
 #ifdef MAGSIM_AVX512_KERNEL
+  const bool bound = v.rad != nullptr;
   if (simd_kernel_active()) {
-    if (terms == PairTerms::HJ) sum_pairs_f32_avx512<true>(v, t, eps2, H, J);
-    else sum_pairs_f32_avx512<false>(v, t, eps2, H, J);
+    if (terms == PairTerms::HJ) {
+      if (bound) sum_pairs_f32_avx512<true, true>(v, t, eps2, H, J);
+      else sum_pairs_f32_avx512<true, false>(v, t, eps2, H, J);
+    } else {
+      if (bound) sum_pairs_f32_avx512<false, true>(v, t, eps2, H, J);
+      else sum_pairs_f32_avx512<false, false>(v, t, eps2, H, J);
+    }
     return;
   }
+#else
+  const bool bound = v.rad != nullptr;
 #endif
-  if (terms == PairTerms::HJ) sum_pairs_f32_portable<true>(v, t, eps2, H, J);
-  else sum_pairs_f32_portable<false>(v, t, eps2, H, J);
+  if (terms == PairTerms::HJ) {
+    if (bound) sum_pairs_f32_portable<true, true>(v, t, eps2, H, J);
+    else sum_pairs_f32_portable<true, false>(v, t, eps2, H, J);
+  } else {
+    if (bound) sum_pairs_f32_portable<false, true>(v, t, eps2, H, J);
+    else sum_pairs_f32_portable<false, false>(v, t, eps2, H, J);
+  }
 }
 
 }  // namespace magsim::mag::detail

@@ -381,10 +381,10 @@ int main(int argc, char** argv) {
           }
           const mag::detail::SourceView vd{sd.x.data(), sd.y.data(), sd.z.data(), sd.mx.data(),
                                            sd.my.data(), sd.mz.data(), sd.id.data(), sd.grp.data(),
-                                           sd.size()};
+                                           sd.size(), nullptr};
           const mag::detail::SourceViewF vf{f[0].data(), f[1].data(), f[2].data(), f[3].data(),
                                             f[4].data(), f[5].data(), fid.data(), fgrp.data(),
-                                            fid.size()};
+                                            fid.size(), nullptr};
           double sink = 0;
           auto kernel = [&](bool fl, bool jac) {
             const auto terms = jac ? mag::detail::PairTerms::HJ : mag::detail::PairTerms::H;
@@ -397,10 +397,10 @@ int main(int argc, char** argv) {
                   if (fl) {
                     const Vec3 r = p - c;
                     const mag::detail::TargetF t{float(r.x()), float(r.y()), float(r.z()), k,
-                                                 set.group[k] >= 0 ? set.group[k] : mag::detail::kNoGroupF};
+                                                 set.group[k] >= 0 ? set.group[k] : mag::detail::kNoGroupF, 0.0f};
                     mag::detail::sum_pairs_f32(vf, t, 0.0f, terms, h, jj);
                   } else {
-                    const mag::detail::Target t{p.x(), p.y(), p.z(), double(k), g};
+                    const mag::detail::Target t{p.x(), p.y(), p.z(), double(k), g, 0.0};
                     mag::detail::sum_pairs(vd, t, 0.0, terms, h, jj);
                   }
                   sink += h[0] + jj[0];

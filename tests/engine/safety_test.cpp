@@ -84,6 +84,15 @@ TEST_CASE("safety: coincident moments make the magnetics non-finite: caught, rol
   src.moments.push_back(md);
   s.bodies.push_back(src);
   s.bodies.push_back(iron_ball("victim", Vec3(0, 0, 0.05)));
+  {
+    // with bounded pairs the pair is evaluated at the ball's radius: finite
+    SceneDesc b = s;
+    b.options.magnetics.field.bounded_pairs = true;
+    engine::Simulation bounded(b);
+    CHECK_NOTHROW(bounded.step());
+  }
+  // point dipoles: r = 0 is singular
+  s.options.magnetics.field.bounded_pairs = false;
   engine::Simulation sim(s);
   const std::uint64_t h0 = sim.state_hash();
   try {

@@ -512,12 +512,12 @@ TEST_CASE("Float pair kernel: softening, self and same-group exclusions as the d
     fgrp.push_back(-1);
   }
   const detail::SourceView vd{sb.x.data(), sb.y.data(), sb.z.data(), sb.mx.data(), sb.my.data(),
-                              sb.mz.data(), sb.id.data(), sb.grp.data(), sb.size()};
+                              sb.mz.data(), sb.id.data(), sb.grp.data(), sb.size(), nullptr};
   const detail::SourceViewF vf{f[0].data(), f[1].data(), f[2].data(), f[3].data(), f[4].data(),
-                               f[5].data(), fid.data(), fgrp.data(), fid.size()};
+                               f[5].data(), fid.data(), fgrp.data(), fid.size(), nullptr};
   const int self = 7;  // in group 5
-  const detail::Target td{sb.x[self], sb.y[self], sb.z[self], double(self), 5.0};
-  const detail::TargetF tf{f[0][self], f[1][self], f[2][self], self, 5};
+  const detail::Target td{sb.x[self], sb.y[self], sb.z[self], double(self), 5.0, 0.0};
+  const detail::TargetF tf{f[0][self], f[1][self], f[2][self], self, 5, 0.0f};
   for (double eps : {0.0, 2e-3}) {
     for (bool simd : {true, false}) {
       detail::enable_simd_kernel(simd);
