@@ -18,12 +18,15 @@
 //       "max_contacts": 4, "space": "sap" | "hash" | "simple", "auto_disable": false,
 //       "linear_damping": 0, "angular_damping": 0, "surface_layer": 0,
 //       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
+//       "force_model": "method" | "zeeman" | "classic", "max_substeps": 1,
+//       "substep_reach": 0.25, "rolling_friction": 0, "quickstep_w": 1.3,
 //       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]
 //       "bh_threshold": 2500,                   // auto: Barnes–Hut from this many moments
 //       "magnetics": {"dt": 1e-7, "beta": 5, "alpha": 0.2, "gamma_c_max": 1,
 //                     "adaptive_gamma_bound": true, "adaptive_gamma_cap": 2.5,
 //                     "tol": 1e-4, "max_iter": 100, "min_pair_angle": 1e-6,
-//                     "theta_integrator": "exact" | "euler", "softening": 0}
+//                     "theta_integrator": "exact" | "euler", "softening": 0,
+//                     "bounded_pairs": false}
 //     },
 //     "bodies": [                               // required
 //       {"name": "ball_0", "type": "dynamic" | "kinematic" | "static",
@@ -36,7 +39,8 @@
 //                    "size": r | [r] | [hx,hy,hz] | [r, half_length]}],
 //        "moments": [{"offset": [x,y,z], "permanent": false, "volume": V,   // V > 0 (m³)
 //                     "Ms": 1.6e6,               // induced only (A/m)
-//                     "moment": [mx,my,mz]}]}    // permanent only (A·m², body frame)
+//                     "moment": [mx,my,mz],      // permanent only (A·m², body frame)
+//                     "interaction_radius": -1}]} // bounded pairs (m); < 0 = from the shape
 //     ]
 //   }
 //
@@ -262,7 +266,7 @@ ShapeDesc read_shape(const Reader& r, const json& j, const std::string& path) {
 }
 
 MomentDesc read_moment(const Reader& r, const json& j, const std::string& path) {
-  r.keys(j, path, {"offset", "permanent", "volume", "Ms", "moment"});
+  r.keys(j, path, {"offset", "permanent", "volume", "Ms", "moment", "interaction_radius"});
   MomentDesc m;
   opt(j, "offset", path, [&](const json& v, const std::string& p) { m.offset = r.vec3(v, p); });
   opt(j, "permanent", path, [&](const json& v, const std::string& p) { m.permanent = r.boolean(v, p); });
@@ -276,6 +280,7 @@ MomentDesc read_moment(const Reader& r, const json& j, const std::string& path) 
     if (!m.permanent) r.fail(p, "only for permanent moments (\"permanent\": true)");
     m.moment = r.vec3(v, p);
   });
+  opt(j, "interaction_radius", path, [&](const json& v, const std::string& p) { m.interaction_radius = r.number(v, p); });
   return m;
 }
 
@@ -310,7 +315,8 @@ BodyDesc read_body(const Reader& r, const json& j, const std::string& path, std:
 
 void read_magnetics(const Reader& r, const json& j, const std::string& path, mag::DynamicsOptions* d) {
   r.keys(j, path, {"dt", "beta", "alpha", "gamma_c_max", "adaptive_gamma_bound", "adaptive_gamma_cap",
-                   "tol", "criterion", "max_iter", "min_pair_angle", "theta_integrator", "softening"});
+                   "tol", "criterion", "max_iter", "min_pair_angle", "theta_integrator", "softening",
+                   "bounded_pairs"});
   opt(j, "dt", path, [&](const json& v, const std::string& p) { d->dt = r.in_range(v, p, 1e-9, 1e-6); });
   opt(j, "beta", path, [&](const json& v, const std::string& p) { d->beta = r.positive(v, p); });
   opt(j, "alpha", path, [&](const json& v, const std::string& p) { d->alpha = r.in_range(v, p, 1e-12, 1.0); });
@@ -333,6 +339,7 @@ void read_magnetics(const Reader& r, const json& j, const std::string& path, mag
     else r.fail(p, "unknown criterion '" + s + "' (residual, change)");
   });
   opt(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.non_negative(v, p); });
+  opt(j, "bounded_pairs", path, [&](const json& v, const std::string& p) { d->field.bounded_pairs = r.boolean(v, p); });
   const std::string e = mag::validate(*d);
   if (!e.empty()) r.fail(path, e);
 }
@@ -342,7 +349,8 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
                    "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
                    "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
-                   "magnetics"});
+                   "magnetics", "force_model", "max_substeps", "substep_reach", "rolling_friction",
+                   "quickstep_w"});
   opt(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   opt(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
@@ -364,6 +372,17 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
   opt(j, "max_correcting_velocity", path, [&](const json& v, const std::string& p) { o->max_correcting_velocity = r.non_negative(v, p); });
   opt(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
   opt(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = r.integer(v, p, 0, 1024); });
+  opt(j, "force_model", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic)");
+  });
+  opt(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = r.integer(v, p, 1, 64); });
+  opt(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.positive(v, p); });
+  opt(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.non_negative(v, p); });
+  opt(j, "quickstep_w", path, [&](const json& v, const std::string& p) {
+    o->quickstep_w = r.number(v, p);
+    if (!(o->quickstep_w > 0 && o->quickstep_w < 2)) r.fail(p, "must be in (0, 2) (got " + Reader::fmt(o->quickstep_w) + ")");
+  });
   opt(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
   mag::FieldOptions& f = o->magnetics.field;
   opt(j, "field_solver", path, [&](const json& v, const std::string& p) {

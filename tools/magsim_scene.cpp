@@ -64,6 +64,13 @@ struct Args {
   int quickstep_iterations = 0;
   std::string space;
   bool auto_disable = false;
+  std::string force_model;
+  int max_substeps = 0;
+  double substep_reach = 0.0;
+  double rolling_friction = 0.0;
+  double quickstep_w = 0.0;
+  double dt = 0.0;
+  std::string bounded_pairs;
   magsim::tools::FieldFlags field;
   bool list = false;
 };
@@ -108,6 +115,18 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
   if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
   if (app.count("--auto-disable")) s.options.auto_disable = true;
+  if (app.count("--force-model") && !engine::parse_force_choice(a.force_model, &s.options.force_model))
+    throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman or classic)");
+  if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
+  if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
+  if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
+  if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
+  if (app.count("--dt")) s.options.dt = a.dt;
+  if (app.count("--bounded-pairs")) {
+    if (a.bounded_pairs != "on" && a.bounded_pairs != "off")
+      throw UsageError("--bounded-pairs: expected on or off, got '" + a.bounded_pairs + "'");
+    s.options.magnetics.field.bounded_pairs = a.bounded_pairs == "on";
+  }
   if (app.count("--space")) {
     if (!engine::parse_space(a.space, &s.options.space))
       throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
@@ -204,6 +223,7 @@ class Recorder {
     series_["iterations"].push_back(x.iterations);
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
+    series_["substeps"].push_back(sim_.last_profile().substeps);
     return true;
   }
   int frames() const { return frames_; }
@@ -248,6 +268,12 @@ json options_json(const engine::Model& m) {
               {"max_contacts", o.max_contacts},
               {"space", engine::space_name(o.space)},
               {"auto_disable", o.auto_disable},
+              {"force_model", engine::force_choice_name(o.force_model)},
+              {"max_substeps", o.max_substeps},
+              {"substep_reach", o.substep_reach},
+              {"rolling_friction", o.rolling_friction},
+              {"quickstep_w", o.quickstep_w},
+              {"bounded_pairs", d.field.bounded_pairs},
               {"linear_damping", o.linear_damping},
               {"angular_damping", o.angular_damping},
               {"surface_layer", o.surface_layer},
@@ -343,6 +369,8 @@ int run(const Args& a, const CLI::App& app) {
   total.reserve(n_steps);
   iters.reserve(n_steps);
   long cap_hits = 0;
+  std::vector<double> substeps;  // rigid sub-steps per frame
+  substeps.reserve(n_steps);
   std::string error;
 
   using clock = std::chrono::steady_clock;
@@ -365,6 +393,7 @@ int run(const Args& a, const CLI::App& app) {
     total.push_back(p.total_ms);
     iters.push_back(p.iterations);
     cap_hits += p.cap_hit ? 1 : 0;
+    substeps.push_back(p.substeps);
     if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
     const auto now = clock::now();
     if (now - last_report >= std::chrono::seconds(2)) {
@@ -421,6 +450,12 @@ int run(const Args& a, const CLI::App& app) {
         {"max", iters.empty() ? 0.0 : *std::max_element(iters.begin(), iters.end())},
         {"mean", iters.empty() ? 0.0 : sum(iters) / static_cast<double>(iters.size())},
         {"cap_hits", cap_hits}}},
+      // rigid sub-steps per 1 frame step (SimOptions::max_substeps); T_i/T_f/T_r above are
+      // per frame, all of its sub-steps included
+      {"substeps",
+       {{"median", median(substeps)},
+        {"max", substeps.empty() ? 0.0 : *std::max_element(substeps.begin(), substeps.end())},
+        {"mean", substeps.empty() ? 0.0 : sum(substeps) / static_cast<double>(substeps.size())}}},
       {"final",
        {{"kinetic_energy", fin.kinetic_energy},
         {"max_speed", fin.max_speed},
@@ -487,6 +522,24 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100000));
   app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
+  app.add_option("--force-model", a.force_model,
+                 "force on induced moments: method (the method's own: classic for kim2018, eq. 4 "
+                 "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) (default: the scene's, method)");
+  app.add_option("--max-substeps", a.max_substeps,
+                 "most rigid sub-steps per frame; a frame is split when bodies move fast (1 = never; default: the scene's)")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--substep-reach", a.substep_reach,
+                 "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rolling-friction", a.rolling_friction,
+                 "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
+      ->check(CLI::Range(1e-6, 1.999999));
+  app.add_option("--dt", a.dt, "rigid (frame) step dt_r in seconds, (0, 0.1] (default: the scene's, 1e-3)")
+      ->check(CLI::Range(1e-7, 0.1));
+  app.add_option("--bounded-pairs", a.bounded_pairs,
+                 "on | off: evaluate a pair of moments no closer than the sum of their interaction radii (default: the scene's, off)");
   a.field.add(&app,
               "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
