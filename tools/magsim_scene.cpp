@@ -6,8 +6,9 @@
 //   magsim-scene balls_up --method kim2018 --seconds 2
 //   magsim-scene scenes/examples/two_balls.json --steps 500 --out out/two
 //
-// Exit codes: 0 done, 1 the simulation failed (SimulationError; summary.json holds the
-// error and the last good state), 2 bad usage or a bad scene.
+// Exit codes (the same in magsolve): 0 done, 1 bad usage, flags or scene, 2 the simulation
+// failed (SimulationError; summary.json holds the error and the last good state), 3 I/O
+// error (an output file could not be written).
 #include "engine/simulation.hpp"
 #ifdef MAGSIM_HAVE_RENDER
 #include "render/frame_writer.hpp"
@@ -31,6 +32,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -40,6 +42,25 @@ namespace scenes = magsim::scenes;
 using nlohmann::json;
 
 namespace {
+
+enum Exit { kOk = 0, kBadInput = 1, kRunFailed = 2, kIoError = 3 };
+
+// Runs above this many rigid steps are refused up front: the per-step timings alone take
+// 56 bytes a step (560 MB here), and at ~1 ms a step it is hours of wall time; a typo such
+// as --seconds 1e8 or "dt": 1e-12 would otherwise end in bad_alloc.
+constexpr double kMaxSteps = 1e7;
+
+// --threads above 4x the cores only slows the run down, and 1e5 makes libgomp crash
+int max_threads() {
+  const unsigned cores = std::thread::hardware_concurrency();
+  return 4 * static_cast<int>(cores > 0 ? cores : 1);
+}
+
+std::string fmt(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -102,7 +123,12 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   }
   if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
     throw UsageError("unknown method '" + a.method + "'");
-  if (app.count("--threads")) s.options.threads = a.threads;
+  if (app.count("--threads")) {
+    if (a.threads > max_threads())
+      throw UsageError("--threads: at most " + std::to_string(max_threads()) + " (4 x the " +
+                       std::to_string(max_threads() / 4) + " cores), got " + std::to_string(a.threads));
+    s.options.threads = a.threads;
+  }
   if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
   if (app.count("--tol")) s.options.magnetics.tol = a.tol;
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
@@ -323,12 +349,25 @@ int run(const Args& a, const CLI::App& app) {
   const engine::Model& model = sim.model();
   const double dt = model.options.dt;
 
+  // the run's length, checked in double before any conversion to long
   long n_steps = a.steps;
   if (!app.count("--steps")) {
-    const double seconds = app.count("--seconds") ? a.seconds : scene.default_seconds;
-    n_steps = std::max(1L, std::lround(seconds / dt));
+    const bool flag = app.count("--seconds") > 0;
+    const double seconds = flag ? a.seconds : scene.default_seconds;
+    const std::string what = flag ? "--seconds " + fmt(seconds) : "the scene's default_seconds " + fmt(seconds);
+    if (seconds < dt * (1 - 1e-9))
+      throw UsageError(what + " is shorter than one rigid step (dt = " + fmt(dt) + " s)");
+    const double want = seconds / dt;
+    if (want > kMaxSteps)
+      throw UsageError(what + " at dt = " + fmt(dt) + " s is " + fmt(want) + " steps, more than the bound of " +
+                       fmt(kMaxSteps) + " steps");
+    n_steps = std::max(1L, std::lround(want));
   }
-  const long per_frame = std::max(1L, std::lround(1.0 / (a.fps * dt)));
+  if (static_cast<double>(n_steps) > kMaxSteps)
+    throw UsageError("--steps " + std::to_string(n_steps) + ": more than the bound of " + fmt(kMaxSteps) + " steps");
+  // a frame every per_frame steps; below one frame per run only the first and last are kept
+  const double frame_steps = 1.0 / (a.fps * dt);
+  const long per_frame = frame_steps >= static_cast<double>(n_steps) ? n_steps : std::max(1L, std::lround(frame_steps));
   const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
   prepare_out_dir(dir);
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
@@ -438,11 +477,11 @@ int run(const Args& a, const CLI::App& app) {
   out << summary.dump(1) << '\n';
   if (!out) {
     std::fprintf(stderr, "error: cannot write %s\n", path.c_str());
-    return 1;
+    return kIoError;
   }
   if (!error.empty()) {
     std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
-    return 1;
+    return kRunFailed;
   }
   const mag::FieldOptions& fo = model.options.magnetics.field;
   std::fprintf(stderr,
@@ -451,8 +490,32 @@ int run(const Args& a, const CLI::App& app) {
                scene.name.c_str(), method.c_str(), sim.steps(), sim.time(), wall, median(Ti), median(Tf),
                median(Tr), median(total), mag::field_solver_name(mag::resolve_solver(fo, static_cast<std::size_t>(model.nmoment))),
                mag::field_solver_name(fo.solver), model.nmoment, path.c_str());
-  return 0;
+  return kOk;
 }
+
+// --seconds / --fps: CLI::PositiveNumber lets nan and inf through
+const auto kFinitePositive = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        const double x = std::stod(v);
+        if (std::isfinite(x) && x > 0) return {};
+      } catch (const std::exception&) {
+      }
+      return "must be a finite number > 0, got " + v;
+    },
+    "POSITIVE");
+
+// --width / --height: H.264 (tools/make_video.sh) needs even frame sizes
+const auto kEven = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        if (std::stol(v) % 2 == 0) return {};
+      } catch (const std::exception&) {
+        return {};  // the Range check names it
+      }
+      return "must be even (H.264), got " + v;
+    },
+    "EVEN");
 
 }  // namespace
 
@@ -464,19 +527,19 @@ int main(int argc, char** argv) {
   app.add_option("--method", a.method, "ours-realigned | ours | kim2018 | damping-llg | anderson | exact (default: the scene's, ours-realigned)")
       ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "anderson", "exact"}));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
-                      ->check(CLI::PositiveNumber);
-  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, 2000000000L));
+                      ->check(kFinitePositive);
+  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, static_cast<long>(kMaxSteps)));
   seconds->excludes(steps);
   steps->excludes(seconds);
   app.add_option("--out", a.out, "output directory (default: out/<scene>_<method>)");
-  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60), in [0.001, 1e9]")
+      ->check(kFinitePositive & CLI::Range(1e-3, 1e9));
   app.add_flag("--no-render", a.no_render, "do not render frames");
-  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192))->capture_default_str();
-  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192))->capture_default_str();
+  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
   app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(CLI::Range(1, 4))->capture_default_str();
   app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
-  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics")->check(CLI::Range(1, 1000000000));
+  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores")->check(CLI::Range(1, 1000000000));
   app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(CLI::Range(1, 1000000000));
   app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(CLI::PositiveNumber);
   app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
@@ -493,13 +556,16 @@ int main(int argc, char** argv) {
               "--bh-threshold moments on");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
 
+  app.footer("Exit codes: 0 done, 1 bad usage, flags or scene, 2 the simulation failed (summary.json "
+             "holds the error), 3 an output file could not be written.\nRuns longer than 1e7 rigid "
+             "steps are refused.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
-    return 2;
+    return kBadInput;
   }
   if (a.list) {
     for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
@@ -507,15 +573,15 @@ int main(int argc, char** argv) {
   }
   if (a.scene.empty()) {
     std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
-    return 2;
+    return kBadInput;
   }
   try {
     return run(a, app);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+    return kBadInput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    return kRunFailed;
   }
 }

@@ -1,0 +1,115 @@
+// tests/tools/reliability_test.cpp — issue #13 "never a crash, never a silent success":
+// inputs that used to abort, segfault, run out of memory or exit 0 with nothing useful
+// done now end in a one-line error and the documented exit code (0 done, 1 bad input or
+// flags, 2 run failed, 3 I/O error).
+#include "tests/tools/run_command.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+namespace {
+
+using magsim::test::CommandResult;
+
+CommandResult scene(const std::string& args) { return magsim::test::run_command(MAGSIM_SCENE_BIN, args); }
+CommandResult solve(const std::string& args) { return magsim::test::run_command(MAGSOLVE_BIN, args); }
+
+std::string input(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tests/tools/inputs/" + name; }
+std::string example(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tools/examples/" + name; }
+
+std::string tmp(const std::string& name) { return "/tmp/reliability_test_" + std::to_string(getpid()) + "_" + name; }
+
+std::size_t lines(const std::string& s) {
+  std::size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("magsolve: a directory as the case file is a one-line error, exit 1", "[reliability]") {
+  const CommandResult r = solve(std::string(MAGSIM_SOURCE_DIR) + "/tools/examples");
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("is a directory") != std::string::npos);
+  CHECK(lines(r.out) == 1);
+}
+
+TEST_CASE("magsim-scene: --threads above 4x the cores is a flag error naming the limit", "[reliability]") {
+  for (const char* n : {"100000", "1000000000"}) {
+    const CommandResult r = scene(std::string("balls_up --count 5 --steps 1 --no-render --out ") + tmp("threads") +
+                                  " --threads " + n);
+    INFO(n << ": " << r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find("--threads: at most") != std::string::npos);
+  }
+}
+
+TEST_CASE("magsolve: a case too big for the Newton reference is refused up front with the size", "[reliability]") {
+  // 20,000 induced moments: 3 matrices of 60,000² doubles = 80 GiB (bad_alloc before #13)
+  const std::string path = tmp("huge.json");
+  {
+    std::ofstream f(path);
+    f << "{\"moments\": [";
+    for (int i = 0; i < 20000; ++i)
+      f << (i ? "," : "") << "{\"position\": [" << 0.02 * (i % 100) << ", " << 0.02 * (i / 100)
+        << ", 0], \"volume\": 5e-7, \"Ms\": 1.6e6, \"kind\": \"induced\"}";
+    f << "]}";
+  }
+  const CommandResult r = solve(path + " --max-iter 1");
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("20000 induced moments") != std::string::npos);
+  CHECK(r.out.find("GiB") != std::string::npos);
+}
+
+TEST_CASE("magsim-scene: non-finite, too small or too large run flags are flag errors", "[reliability]") {
+  struct Case {
+    const char* args;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"--seconds nan", "--seconds"},   {"--seconds inf", "--seconds"},
+      {"--seconds 1e300", "steps"},     {"--seconds 1e8", "1e+11 steps"},
+      {"--seconds 1e-9", "shorter than one rigid step"},
+      {"--fps nan", "--fps"},           {"--fps 1e-300", "--fps"},
+      {"--width 17", "even"},           {"--height 719", "even"},
+      {"--steps 3000000000", "--steps"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = scene(std::string("balls_up --count 5 --no-render --out ") + tmp("flags") + " " + c.args);
+    INFO(c.args << ": exit " << r.code << ", said: " << r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find(c.says) != std::string::npos);
+  }
+}
+
+TEST_CASE("magsim-scene: a scene file whose dt makes too many steps is refused with the numbers", "[reliability]") {
+  const CommandResult r = scene(input("tiny_dt.json") + " --no-render --out " + tmp("tiny_dt"));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("2e+12 steps") != std::string::npos);
+}
+
+TEST_CASE("magsolve: a failed write to stdout is exit 3, not a silent success", "[reliability]") {
+  for (const char* format : {"json", "csv"}) {
+    // stderr to the pipe, stdout to the full device
+    const CommandResult r = magsim::test::run_command(std::string("{ ") + MAGSOLVE_BIN,
+                                                      example("touching_spheres.json") + " --format " + format +
+                                                          " 2>&1 > /dev/full; }");
+    INFO(format << ": " << r.out);
+    CHECK(r.code == 3);
+    CHECK(r.out.find("No space left") != std::string::npos);
+  }
+}
+
+TEST_CASE("magsolve: flag errors exit 1 like bad input", "[reliability]") {
+  for (const char* flags : {"--format xml", "--dt 1", "--method nope", "--max-iter many", "--bogus"}) {
+    const CommandResult r = solve(example("touching_spheres.json") + " " + flags);
+    INFO(flags << ": " << r.out);
+    CHECK(r.code == 1);
+  }
+}
