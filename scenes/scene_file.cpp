@@ -45,6 +45,7 @@
 #include "scenes/scene_file.hpp"
 
 #include "magnetics/magnetization.hpp"
+#include "scenes/json_unique_keys.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -276,6 +277,9 @@ MomentDesc read_moment(const Reader& r, const json& j, const std::string& path) 
     if (!m.permanent) r.fail(p, "only for permanent moments (\"permanent\": true)");
     m.moment = r.vec3(v, p);
   });
+  // a permanent moment without "moment" used to load as a zero magnet
+  if (m.permanent && !j.contains("moment"))
+    r.fail(Reader::join(path, "moment"), "required for a permanent moment ([mx, my, mz], A·m², body frame)");
   return m;
 }
 
@@ -391,6 +395,27 @@ void read_camera(const Reader& r, const json& j, const std::string& path, render
   opt(j, "z_far", path, [&](const json& v, const std::string& p) { c->z_far = static_cast<float>(r.non_negative(v, p)); });
 }
 
+// The scene name becomes the output folder out/<name>_<method>: no path separators, no "."
+// or ".." component, no control bytes, valid UTF-8 (the JSON parser checks the UTF-8 of
+// strings, but not of the file name a default name comes from).
+std::string bad_name_reason(const std::string& name) {
+  if (name.empty()) return "must not be empty";
+  if (name == "." || name == "..") return "must not be '.' or '..'";
+  std::size_t i = 0;
+  while (i < name.size()) {
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (c == '/' || c == '\\') return "must not contain '/' or '\\' (it names the output folder)";
+    if (c < 0x20 || c == 0x7f) return "must not contain control characters";
+    int extra = c < 0x80 ? 0 : (c & 0xe0) == 0xc0 ? 1 : (c & 0xf0) == 0xe0 ? 2 : (c & 0xf8) == 0xf0 ? 3 : -1;
+    if (extra < 0 || (extra == 1 && c < 0xc2) || i + extra >= name.size())
+      return "must be valid UTF-8";
+    for (int k = 1; k <= extra; ++k)
+      if ((static_cast<unsigned char>(name[i + k]) & 0xc0) != 0x80) return "must be valid UTF-8";
+    i += 1 + extra;
+  }
+  return {};
+}
+
 std::string stem(const std::string& path) {
   const std::size_t slash = path.find_last_of("/\\");
   std::string s = slash == std::string::npos ? path : path.substr(slash + 1);
@@ -404,7 +429,9 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   const Reader r(origin);
   json doc;
   try {
-    doc = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    doc = parse_unique_keys(text, /*ignore_comments=*/true);
+  } catch (const DuplicateKeyError& e) {  // "bodies[0].position: duplicate key"
+    r.fail("", e.what());
   } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
     std::string what = e.what();
     const std::size_t close = what.find("] ");  // drop "[json.exception.parse_error.101] "
@@ -417,6 +444,8 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   SceneDesc s;
   s.name = stem(origin);
   opt(doc, "name", "", [&](const json& v, const std::string& p) { s.name = r.string(v, p); });
+  if (const std::string why = bad_name_reason(s.name); !why.empty())
+    r.fail(doc.contains("name") ? "name" : "(file name)", "the scene name " + why);
   opt(doc, "description", "", [&](const json& v, const std::string& p) { s.description = r.string(v, p); });
   opt(doc, "modelling_level", "", [&](const json& v, const std::string& p) { s.modelling_level = r.string(v, p); });
   opt(doc, "default_seconds", "", [&](const json& v, const std::string& p) { s.default_seconds = r.positive(v, p); });

@@ -6,6 +6,7 @@
 // (non-finite solution), 3 I/O error (the output could not be written).
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
+#include "scenes/json_unique_keys.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -187,7 +188,9 @@ int run(int argc, char** argv) {
     const std::string text = read_text(path);
     json doc;
     try {
-      doc = json::parse(text);
+      doc = magsim::scenes::parse_unique_keys(text);
+    } catch (const magsim::scenes::DuplicateKeyError& e) {
+      throw InputError(e.what());
     } catch (const json::exception& e) {  // syntax errors and numbers out of range
       throw InputError(std::string("malformed JSON: ") + e.what());
     }

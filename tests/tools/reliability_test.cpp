@@ -113,3 +113,21 @@ TEST_CASE("magsolve: flag errors exit 1 like bad input", "[reliability]") {
     CHECK(r.code == 1);
   }
 }
+
+TEST_CASE("duplicate JSON keys are errors naming the key and path, in both tools", "[reliability]") {
+  const CommandResult s = scene(input("duplicate_key.json") + " --steps 1 --no-render --out " + tmp("dup"));
+  INFO(s.out);
+  CHECK(s.code == 1);
+  CHECK(s.out.find("bodies[0].position: duplicate key") != std::string::npos);
+  const CommandResult m = solve(input("duplicate_key_magsolve.json"));
+  INFO(m.out);
+  CHECK(m.code == 1);
+  CHECK(m.out.find("moments[0].volume: duplicate key") != std::string::npos);
+}
+
+TEST_CASE("magsim-scene: a permanent moment without \"moment\" is refused", "[reliability]") {
+  const CommandResult r = scene(input("permanent_without_moment.json") + " --steps 1 --no-render --out " + tmp("perm"));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("bodies[0].moments[0].moment: required") != std::string::npos);
+}
