@@ -22,10 +22,12 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -65,6 +67,35 @@ std::string fmt(double x) {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// an output file could not be written (exit 3)
+struct IoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::string errno_text() { return errno ? std::strerror(errno) : "write error"; }
+
+// The names this program writes into --out; a run deletes its own old outputs first (so a
+// shorter rerun leaves no stale frame_*.png for make_video.sh) and never anything else.
+const char* const kOutputNames[] = {"summary.json", "summary.json.tmp", "states.csv", "moments.csv"};
+bool is_output_name(const std::string& f) {
+  for (const char* n : kOutputNames)
+    if (f == n) return true;
+  // frame_%06d.png (six or more digits)
+  const std::size_t digits = f.size() >= 10 ? f.size() - 10 : 0;
+  if (f.size() < 16 || f.compare(0, 6, "frame_") != 0 || f.compare(f.size() - 4, 4, ".png") != 0) return false;
+  for (std::size_t i = 6; i < 6 + digits; ++i)
+    if (f[i] < '0' || f[i] > '9') return false;
+  return true;
+}
+
+// RFC 4180: a field with a comma, quote or line break is quoted, quotes doubled; other
+// fields are written as they are (so ordinary output does not change)
+std::string csv_field(const std::string& v) {
+  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string q = "\"";
+  for (char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
 
 struct Args {
   std::string scene;
@@ -149,7 +180,8 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   return s;
 }
 
-// Creates DIR (and parents) and checks that files can be written into it.
+// Creates DIR (and parents), checks that files can be written into it and deletes the
+// outputs of an earlier run there (only this program's own names, see is_output_name).
 void prepare_out_dir(const std::string& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
@@ -162,6 +194,12 @@ void prepare_out_dir(const std::string& dir) {
     if (!f || !(f << "ok") || !f.flush()) throw UsageError("--out " + dir + ": directory is not writable");
   }
   fs::remove(probe, ec);
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    if (!is_output_name(e.path().filename().string()) || e.is_directory(ec)) continue;
+    if (!fs::remove(e.path(), ec) && ec)
+      throw IoError("--out " + dir + ": cannot delete the old " + e.path().filename().string() + " (" + ec.message() + ")");
+  }
+  if (ec) throw IoError("--out " + dir + ": cannot list the directory (" + ec.message() + ")");
 }
 
 double median(std::vector<double> v) {
@@ -184,12 +222,34 @@ json vec3(const engine::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 // Per-frame output: states.csv and moments.csv rows, and the series of summary.json.
 class Recorder {
  public:
-  Recorder(const std::string& dir, const engine::Simulation& sim) : sim_(sim) {
-    states_ = std::fopen((fs::path(dir) / "states.csv").c_str(), "w");
-    moments_ = std::fopen((fs::path(dir) / "moments.csv").c_str(), "w");
-    if (!states_ || !moments_) throw UsageError("--out " + dir + ": cannot create states.csv / moments.csv");
+  Recorder(const std::string& dir, const engine::Simulation& sim)
+      : sim_(sim), states_path_((fs::path(dir) / "states.csv").string()),
+        moments_path_((fs::path(dir) / "moments.csv").string()) {
+    states_ = std::fopen(states_path_.c_str(), "w");
+    if (!states_) throw IoError("cannot create " + states_path_ + " (" + errno_text() + ")");
+    moments_ = std::fopen(moments_path_.c_str(), "w");
+    if (!moments_) throw IoError("cannot create " + moments_path_ + " (" + errno_text() + ")");
     std::fprintf(states_, "frame,time,body,name,x,y,z,qw,qx,qy,qz\n");
     std::fprintf(moments_, "frame,time,moment,body,x,y,z,Mx,My,Mz,M1x,M1y,M1z,M2x,M2y,M2z\n");
+    check();
+  }
+  /// Flushes and closes both files; throws IoError naming the file that failed.
+  void close() {
+    std::FILE* s = states_;
+    std::FILE* m = moments_;
+    states_ = moments_ = nullptr;
+    errno = 0;
+    const bool s_ok = std::fflush(s) == 0 && !std::ferror(s);
+    const std::string s_err = errno_text();
+    const bool s_closed = std::fclose(s) == 0;
+    if (!s_ok || !s_closed) {
+      std::fclose(m);
+      throw IoError("writing " + states_path_ + " failed (" + s_err + ")");
+    }
+    errno = 0;
+    const bool m_ok = std::fflush(m) == 0 && !std::ferror(m);
+    const std::string m_err = errno_text();
+    if (std::fclose(m) != 0 || !m_ok) throw IoError("writing " + moments_path_ + " failed (" + m_err + ")");
   }
   ~Recorder() {
     if (states_) std::fclose(states_);
@@ -211,7 +271,7 @@ class Recorder {
       const engine::Vec3& p = s.pos[b];
       const engine::Quat& q = s.quat[b];
       std::fprintf(states_, "%d,%.9g,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", f, t, b,
-                   m.body_name[b].c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
+                   csv_field(m.body_name[b]).c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
     }
     const mag::MomentSet& ms = sim_.moments();
     for (int j = 0; j < m.nmoment; ++j) {
@@ -230,13 +290,21 @@ class Recorder {
     series_["iterations"].push_back(x.iterations);
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
+    check();
     return true;
   }
   int frames() const { return frames_; }
   const json& series() const { return series_; }
 
  private:
+  // a failed write (full disk …) sets the stream's error flag; stop at the first
+  void check() const {
+    if (std::ferror(states_)) throw IoError("writing " + states_path_ + " failed (" + errno_text() + ")");
+    if (std::ferror(moments_)) throw IoError("writing " + moments_path_ + " failed (" + errno_text() + ")");
+  }
+
   const engine::Simulation& sim_;
+  std::string states_path_, moments_path_;
   std::FILE* states_ = nullptr;
   std::FILE* moments_ = nullptr;
   long last_step_ = -1;
@@ -369,6 +437,13 @@ int run(const Args& a, const CLI::App& app) {
   const double frame_steps = 1.0 / (a.fps * dt);
   const long per_frame = frame_steps >= static_cast<double>(n_steps) ? n_steps : std::max(1L, std::lround(frame_steps));
   const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
+  // summary.json must not overwrite the scene file it was made from (--out = its folder)
+  if (ends_with(a.scene, ".json"))
+    for (const char* n : kOutputNames) {
+      std::error_code ec;
+      if (fs::equivalent(fs::path(dir) / n, a.scene, ec))
+        throw UsageError("--out " + dir + ": the output " + n + " would overwrite the input scene file " + a.scene);
+    }
   prepare_out_dir(dir);
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
@@ -387,40 +462,50 @@ int run(const Args& a, const CLI::App& app) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   auto last_report = t0;
-  if (rec.frame()) painter.draw(sim);
-  for (long k = 0; k < n_steps; ++k) {
-    try {
-      sim.step();
-    } catch (const engine::SimulationError& e) {
-      error = e.what();
-      break;
+  std::string io_error;  // the first failed write; the run stops there
+  try {
+    if (rec.frame()) painter.draw(sim);
+    for (long k = 0; k < n_steps; ++k) {
+      try {
+        sim.step();
+      } catch (const engine::SimulationError& e) {
+        error = e.what();
+        break;
+      }
+      const engine::StepProfile& p = sim.last_profile();
+      Ti.push_back(p.T_i);
+      Tf.push_back(p.T_f);
+      Tr.push_back(p.T_r);
+      collide.push_back(p.collide_ms);
+      quickstep.push_back(p.quickstep_ms);
+      total.push_back(p.total_ms);
+      iters.push_back(p.iterations);
+      cap_hits += p.cap_hit ? 1 : 0;
+      if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
+      const auto now = clock::now();
+      if (now - last_report >= std::chrono::seconds(2)) {
+        last_report = now;
+        std::fprintf(stderr,
+                     "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
+                     "iterations %d%s\n",
+                     scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
+                     std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
+                     p.cap_hit ? " (cap)" : "");
+      }
     }
-    const engine::StepProfile& p = sim.last_profile();
-    Ti.push_back(p.T_i);
-    Tf.push_back(p.T_f);
-    Tr.push_back(p.T_r);
-    collide.push_back(p.collide_ms);
-    quickstep.push_back(p.quickstep_ms);
-    total.push_back(p.total_ms);
-    iters.push_back(p.iterations);
-    cap_hits += p.cap_hit ? 1 : 0;
-    if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
-    const auto now = clock::now();
-    if (now - last_report >= std::chrono::seconds(2)) {
-      last_report = now;
-      std::fprintf(stderr,
-                   "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
-                   "iterations %d%s\n",
-                   scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
-                   std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
-                   p.cap_hit ? " (cap)" : "");
-    }
+    if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
+  } catch (const IoError& e) {
+    io_error = e.what();
   }
-  if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
   try {
     painter.finish();
   } catch (const std::exception& e) {
-    if (error.empty()) error = std::string("writing frames: ") + e.what();
+    if (io_error.empty()) io_error = std::string("writing frames: ") + e.what();
+  }
+  try {
+    rec.close();
+  } catch (const IoError& e) {
+    if (io_error.empty()) io_error = e.what();
   }
   const double wall = std::chrono::duration<double>(clock::now() - t0).count();
 
@@ -470,13 +555,27 @@ int run(const Args& a, const CLI::App& app) {
         {"contacts", fin.contacts}}},
       {"series", rec.series()},
       {"state_hash", hash},
-      {"error", error.empty() ? json(nullptr) : json(error)}};
+      {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};
 
+  // written to a temporary name and renamed when complete: a full disk leaves no
+  // summary.json that looks valid
   const fs::path path = fs::path(dir) / "summary.json";
-  std::ofstream out(path);
-  out << summary.dump(1) << '\n';
-  if (!out) {
-    std::fprintf(stderr, "error: cannot write %s\n", path.c_str());
+  const fs::path tmp = fs::path(dir) / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << summary.dump(1) << '\n';
+    out.close();
+    std::error_code ec;
+    if (!out || (fs::rename(tmp, path, ec), ec)) {
+      const std::string why = ec ? ec.message() : errno_text();
+      fs::remove(tmp, ec);
+      std::fprintf(stderr, "error: cannot write %s (%s)%s%s\n", path.c_str(), why.c_str(),
+                   io_error.empty() ? "" : "; before that: ", io_error.c_str());
+      return kIoError;
+    }
+  }
+  if (!io_error.empty()) {
+    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", io_error.c_str(), path.c_str());
     return kIoError;
   }
   if (!error.empty()) {
@@ -569,7 +668,11 @@ int main(int argc, char** argv) {
   }
   if (a.list) {
     for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
-    return 0;
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      std::fprintf(stderr, "error: writing the list to stdout failed (%s)\n", errno_text().c_str());
+      return kIoError;
+    }
+    return kOk;
   }
   if (a.scene.empty()) {
     std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
@@ -580,6 +683,9 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kBadInput;
+  } catch (const IoError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kIoError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kRunFailed;

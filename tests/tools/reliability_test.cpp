@@ -6,7 +6,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <unistd.h>
 
@@ -130,4 +132,62 @@ TEST_CASE("magsim-scene: a permanent moment without \"moment\" is refused", "[re
   INFO(r.out);
   CHECK(r.code == 1);
   CHECK(r.out.find("bodies[0].moments[0].moment: required") != std::string::npos);
+}
+
+TEST_CASE("magsim-scene: body names with commas, quotes or line breaks are quoted in states.csv", "[reliability]") {
+  const std::string out = tmp("names");
+  const CommandResult r = scene(input("odd_body_name.json") + " --steps 1 --no-render --out " + out);
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::ifstream f(out + "/states.csv");
+  const std::string csv((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  CHECK(csv.find("0,0,0,\"ball, \"\"zero\"\"\nline\",0,0,0.005,") != std::string::npos);
+  CHECK(csv.find("0,0,1,plain,0.02,") != std::string::npos);  // ordinary names stay unquoted
+}
+
+TEST_CASE("magsim-scene: --out in the scene file's folder may not overwrite the scene file", "[reliability]") {
+  const std::string dir = tmp("same");
+  REQUIRE(std::system(("mkdir -p " + dir + " && cp " + input("odd_body_name.json") + " " + dir + "/summary.json").c_str()) == 0);
+  const CommandResult r = scene(dir + "/summary.json --steps 1 --no-render --out " + dir);
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("would overwrite the input scene file") != std::string::npos);
+  std::ifstream f(dir + "/summary.json");
+  std::string first;
+  std::getline(f, first);
+  CHECK(first.rfind("// a body name", 0) == 0);  // the input is untouched
+}
+
+TEST_CASE("magsim-scene: a rerun deletes its own old outputs (stale frames) and nothing else", "[reliability]") {
+  const std::string dir = tmp("rerun");
+  REQUIRE(std::system(("mkdir -p " + dir + " && touch " + dir + "/frame_000099.png " + dir + "/frame_1234567.png " +
+                       dir + "/keep.txt " + dir + "/frame_x.png " + dir + "/summary.json.tmp").c_str()) == 0);
+  const CommandResult r = scene(input("odd_body_name.json") + " --steps 1 --no-render --out " + dir);
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  auto exists = [&](const char* n) { return std::ifstream(dir + "/" + n).good(); };
+  CHECK(!exists("frame_000099.png"));
+  CHECK(!exists("frame_1234567.png"));
+  CHECK(!exists("summary.json.tmp"));
+  CHECK(exists("keep.txt"));
+  CHECK(exists("frame_x.png"));
+  CHECK(exists("summary.json"));
+}
+
+TEST_CASE("magsim-scene: a full disk is exit 3 naming the file, and leaves no summary.json", "[reliability]") {
+  // a 64 KiB tmpfs; needs root (mount): skipped elsewhere
+  const std::string dir = tmp("full");
+  REQUIRE(std::system(("mkdir -p " + dir).c_str()) == 0);
+  if (std::system(("mount -t tmpfs -o size=64k tmpfs " + dir + " 2>/dev/null").c_str()) != 0) {
+    WARN("cannot mount a tmpfs here (not root?): full-disk test skipped");
+    return;
+  }
+  const CommandResult r = scene(std::string(MAGSIM_SOURCE_DIR) + "/scenes/examples/two_balls.json --steps 1000 "
+                                "--fps 1000 --no-render --out " + dir);
+  const bool summary = std::ifstream(dir + "/summary.json").good();
+  std::system(("umount " + dir).c_str());
+  INFO(r.out);
+  CHECK(r.code == 3);
+  CHECK(r.out.find(".csv failed (No space left on device)") != std::string::npos);
+  CHECK(!summary);
 }
