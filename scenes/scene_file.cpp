@@ -20,6 +20,7 @@
 //       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
 //       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]
 //       "bh_threshold": 2500,                   // auto: Barnes–Hut from this many moments
+//       "max_body_speed": 1000,                 // blow-up guard (m/s), 0 = off
 //       "magnetics": {"dt": 1e-7, "beta": 5, "alpha": 0.2, "gamma_c_max": 1,
 //                     "adaptive_gamma_bound": true, "adaptive_gamma_cap": 2.5,
 //                     "tol": 1e-4, "max_iter": 100, "min_pair_angle": 1e-6,
@@ -346,7 +347,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
                    "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
                    "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
-                   "magnetics"});
+                   "magnetics", "max_body_speed"});
   opt(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   opt(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
@@ -379,6 +380,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
     if (!(f.bh_theta > 0 && f.bh_theta <= 1)) r.fail(p, "must be in (0, 1] (got " + Reader::fmt(f.bh_theta) + ")");
   });
   opt(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = r.integer(v, p, 0, 1000000000); });
+  opt(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
   opt(j, "magnetics", path, [&](const json& v, const std::string& p) { read_magnetics(r, v, p, &o->magnetics); });
   o->magnetics.method = o->method;
 }

@@ -332,6 +332,7 @@ json options_json(const engine::Model& m) {
               {"bh_theta", d.field.bh_theta},
               {"bh_threshold", d.field.auto_threshold},
               {"threads", o.threads},
+              {"max_body_speed", o.max_body_speed},
               {"gravity", vec3(o.gravity)},
               {"ground", o.ground},
               {"friction", o.friction},

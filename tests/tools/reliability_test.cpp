@@ -191,3 +191,19 @@ TEST_CASE("magsim-scene: a full disk is exit 3 naming the file, and leaves no su
   CHECK(r.out.find(".csv failed (No space left on device)") != std::string::npos);
   CHECK(!summary);
 }
+
+TEST_CASE("magsim-scene: a body faster than options.max_body_speed ends the run, exit 2, summary with the error", "[reliability]") {
+  const std::string out = tmp("blow_up");
+  const CommandResult r = scene(input("blow_up.json") + " --steps 50 --no-render --out " + out);
+  INFO(r.out);
+  CHECK(r.code == 2);
+  CHECK(r.out.find("body 1 'ball_0': speed") != std::string::npos);
+  std::ifstream f(out + "/summary.json");
+  const std::string summary((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  CHECK(summary.find("\"error\": \"step ") != std::string::npos);
+  CHECK(summary.find("exceeds options.max_body_speed") != std::string::npos);
+  // 0 turns the guard off
+  const CommandResult off = scene(input("blow_up_guard_off.json") + " --steps 50 --no-render --out " + tmp("blow_up_off"));
+  INFO(off.out);
+  CHECK(off.code == 0);
+}
