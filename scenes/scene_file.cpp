@@ -51,6 +51,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
@@ -463,6 +464,9 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
 }
 
 SceneDesc load_scene_file(const std::string& path) {
+  // a directory opens as an ifstream and reads as empty ("malformed JSON" would mislead)
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open the scene file");
   std::ostringstream text;

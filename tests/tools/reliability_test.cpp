@@ -207,3 +207,12 @@ TEST_CASE("magsim-scene: a body faster than options.max_body_speed ends the run,
   INFO(off.out);
   CHECK(off.code == 0);
 }
+
+TEST_CASE("magsim-scene: a directory named like a scene file is a one-line error, exit 1", "[reliability]") {
+  const std::string dir = tmp("dir.json");
+  REQUIRE(std::system(("mkdir -p " + dir).c_str()) == 0);
+  const CommandResult r = scene(dir + " --steps 1 --no-render --out " + tmp("dir_out"));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("is a directory") != std::string::npos);
+}
