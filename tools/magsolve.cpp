@@ -158,7 +158,7 @@ int run(int argc, char** argv) {
   app.footer(
       "Exit codes: 0 done, 1 bad input or flags, 2 the solve failed, 3 the output could not be "
       "written.\nThe Newton reference needs three dense 3N x 3N matrices for N induced moments; "
-      "above 2 GiB (N > 5461) magsolve refuses the case (exit 1).");
+      "above 2 GiB (N > 3153) magsolve refuses the case (exit 1).");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
