@@ -4,6 +4,7 @@
 #include "engine/safety.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace magsim::engine {
 
@@ -60,6 +61,15 @@ void check_bodies(const Model& m, const State& s, long step) {
     if (!s.angvel[b].allFinite()) raise(m, step, b, "angular velocity", s.angvel[b]);
     if (!s.pos[b].allFinite()) raise(m, step, b, "position", s.pos[b]);
     if (!s.quat[b].coeffs().allFinite()) raise(m, step, b, "orientation", s.quat[b].coeffs());
+    // the blow-up guard: finite but absurd speeds (dynamic bodies; kinematic ones move as told)
+    const double v = s.vel[b].norm(), limit = m.options.max_body_speed;
+    if (limit > 0 && v > limit && m.body_type[b] == BodyType::Dynamic) {
+      const std::string& name = m.body_name[b];
+      char what[160];
+      std::snprintf(what, sizeof what, "speed %.4g m/s exceeds options.max_body_speed = %g m/s (a blow-up?)", v, limit);
+      throw SimulationError(step, b, name, "speed",
+                            "step " + std::to_string(step) + ": body " + std::to_string(b) + " '" + name + "': " + what);
+    }
   }
 }
 

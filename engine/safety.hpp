@@ -37,7 +37,8 @@ void check_magnetization(const Model& model, const mag::MomentSet& set, long ste
 /// Throws SimulationError for the first non-finite magnetic force or torque.
 void check_forces(const Model& model, const Workspace& ws, long step);
 /// Throws SimulationError for the first non-finite position, orientation, velocity or
-/// angular velocity of a dynamic or kinematic body.
+/// angular velocity of a dynamic or kinematic body, or (quantity "speed") a dynamic body
+/// faster than options.max_body_speed.
 void check_bodies(const Model& model, const State& s, long step);
 
 }  // namespace magsim::engine

@@ -22,6 +22,7 @@
 //       "substep_reach": 0.25, "rolling_friction": 0, "quickstep_w": 1.3,
 //       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]
 //       "bh_threshold": 2500,                   // auto: Barnes–Hut from this many moments
+//       "max_body_speed": 1000,                 // blow-up guard (m/s), 0 = off
 //       "magnetics": {"dt": 1e-7, "beta": 5, "alpha": 0.2, "gamma_c_max": 1,
 //                     "adaptive_gamma_bound": true, "adaptive_gamma_cap": 2.5,
 //                     "tol": 1e-4, "max_iter": 100, "min_pair_angle": 1e-6,
@@ -49,10 +50,12 @@
 #include "scenes/scene_file.hpp"
 
 #include "magnetics/magnetization.hpp"
+#include "scenes/json_unique_keys.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
@@ -281,6 +284,9 @@ MomentDesc read_moment(const Reader& r, const json& j, const std::string& path) 
     m.moment = r.vec3(v, p);
   });
   opt(j, "interaction_radius", path, [&](const json& v, const std::string& p) { m.interaction_radius = r.number(v, p); });
+  // a permanent moment without "moment" used to load as a zero magnet
+  if (m.permanent && !j.contains("moment"))
+    r.fail(Reader::join(path, "moment"), "required for a permanent moment ([mx, my, mz], A·m², body frame)");
   return m;
 }
 
@@ -350,7 +356,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
                    "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
                    "magnetics", "force_model", "max_substeps", "substep_reach", "rolling_friction",
-                   "quickstep_w"});
+                   "quickstep_w", "max_body_speed"});
   opt(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   opt(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
@@ -394,6 +400,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
     if (!(f.bh_theta > 0 && f.bh_theta <= 1)) r.fail(p, "must be in (0, 1] (got " + Reader::fmt(f.bh_theta) + ")");
   });
   opt(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = r.integer(v, p, 0, 1000000000); });
+  opt(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
   opt(j, "magnetics", path, [&](const json& v, const std::string& p) { read_magnetics(r, v, p, &o->magnetics); });
   o->magnetics.method = o->method;
 }
@@ -410,6 +417,27 @@ void read_camera(const Reader& r, const json& j, const std::string& path, render
   opt(j, "z_far", path, [&](const json& v, const std::string& p) { c->z_far = static_cast<float>(r.non_negative(v, p)); });
 }
 
+// The scene name becomes the output folder out/<name>_<method>: no path separators, no "."
+// or ".." component, no control bytes, valid UTF-8 (the JSON parser checks the UTF-8 of
+// strings, but not of the file name a default name comes from).
+std::string bad_name_reason(const std::string& name) {
+  if (name.empty()) return "must not be empty";
+  if (name == "." || name == "..") return "must not be '.' or '..'";
+  std::size_t i = 0;
+  while (i < name.size()) {
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (c == '/' || c == '\\') return "must not contain '/' or '\\' (it names the output folder)";
+    if (c < 0x20 || c == 0x7f) return "must not contain control characters";
+    int extra = c < 0x80 ? 0 : (c & 0xe0) == 0xc0 ? 1 : (c & 0xf0) == 0xe0 ? 2 : (c & 0xf8) == 0xf0 ? 3 : -1;
+    if (extra < 0 || (extra == 1 && c < 0xc2) || i + extra >= name.size())
+      return "must be valid UTF-8";
+    for (int k = 1; k <= extra; ++k)
+      if ((static_cast<unsigned char>(name[i + k]) & 0xc0) != 0x80) return "must be valid UTF-8";
+    i += 1 + extra;
+  }
+  return {};
+}
+
 std::string stem(const std::string& path) {
   const std::size_t slash = path.find_last_of("/\\");
   std::string s = slash == std::string::npos ? path : path.substr(slash + 1);
@@ -423,7 +451,9 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   const Reader r(origin);
   json doc;
   try {
-    doc = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    doc = parse_unique_keys(text, /*ignore_comments=*/true);
+  } catch (const DuplicateKeyError& e) {  // "bodies[0].position: duplicate key"
+    r.fail("", e.what());
   } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
     std::string what = e.what();
     const std::size_t close = what.find("] ");  // drop "[json.exception.parse_error.101] "
@@ -436,6 +466,8 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   SceneDesc s;
   s.name = stem(origin);
   opt(doc, "name", "", [&](const json& v, const std::string& p) { s.name = r.string(v, p); });
+  if (const std::string why = bad_name_reason(s.name); !why.empty())
+    r.fail(doc.contains("name") ? "name" : "(file name)", "the scene name " + why);
   opt(doc, "description", "", [&](const json& v, const std::string& p) { s.description = r.string(v, p); });
   opt(doc, "modelling_level", "", [&](const json& v, const std::string& p) { s.modelling_level = r.string(v, p); });
   opt(doc, "default_seconds", "", [&](const json& v, const std::string& p) { s.default_seconds = r.positive(v, p); });
@@ -451,6 +483,9 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
 }
 
 SceneDesc load_scene_file(const std::string& path) {
+  // a directory opens as an ifstream and reads as empty ("malformed JSON" would mislead)
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open the scene file");
   std::ostringstream text;

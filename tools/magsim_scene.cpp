@@ -6,8 +6,9 @@
 //   magsim-scene balls_up --method kim2018 --seconds 2
 //   magsim-scene scenes/examples/two_balls.json --steps 500 --out out/two
 //
-// Exit codes: 0 done, 1 the simulation failed (SimulationError; summary.json holds the
-// error and the last good state), 2 bad usage or a bad scene.
+// Exit codes (the same in magsolve): 0 done, 1 bad usage, flags or scene, 2 the simulation
+// failed (SimulationError; summary.json holds the error and the last good state), 3 I/O
+// error (an output file could not be written).
 #include "engine/simulation.hpp"
 #ifdef MAGSIM_HAVE_RENDER
 #include "render/frame_writer.hpp"
@@ -21,16 +22,19 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -41,9 +45,57 @@ using nlohmann::json;
 
 namespace {
 
+enum Exit { kOk = 0, kBadInput = 1, kRunFailed = 2, kIoError = 3 };
+
+// Runs above this many rigid steps are refused up front: the per-step timings alone take
+// 56 bytes a step (560 MB here), and at ~1 ms a step it is hours of wall time; a typo such
+// as --seconds 1e8 or "dt": 1e-12 would otherwise end in bad_alloc.
+constexpr double kMaxSteps = 1e7;
+
+// --threads above 4x the cores only slows the run down, and 1e5 makes libgomp crash
+int max_threads() {
+  const unsigned cores = std::thread::hardware_concurrency();
+  return 4 * static_cast<int>(cores > 0 ? cores : 1);
+}
+
+std::string fmt(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// an output file could not be written (exit 3)
+struct IoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::string errno_text() { return errno ? std::strerror(errno) : "write error"; }
+
+// The names this program writes into --out; a run deletes its own old outputs first (so a
+// shorter rerun leaves no stale frame_*.png for make_video.sh) and never anything else.
+const char* const kOutputNames[] = {"summary.json", "summary.json.tmp", "states.csv", "moments.csv"};
+bool is_output_name(const std::string& f) {
+  for (const char* n : kOutputNames)
+    if (f == n) return true;
+  // frame_%06d.png (six or more digits)
+  const std::size_t digits = f.size() >= 10 ? f.size() - 10 : 0;
+  if (f.size() < 16 || f.compare(0, 6, "frame_") != 0 || f.compare(f.size() - 4, 4, ".png") != 0) return false;
+  for (std::size_t i = 6; i < 6 + digits; ++i)
+    if (f[i] < '0' || f[i] > '9') return false;
+  return true;
+}
+
+// RFC 4180: a field with a comma, quote or line break is quoted, quotes doubled; other
+// fields are written as they are (so ordinary output does not change)
+std::string csv_field(const std::string& v) {
+  if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+  std::string q = "\"";
+  for (char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
 
 struct Args {
   std::string scene;
@@ -109,7 +161,12 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   }
   if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
     throw UsageError("unknown method '" + a.method + "'");
-  if (app.count("--threads")) s.options.threads = a.threads;
+  if (app.count("--threads")) {
+    if (a.threads > max_threads())
+      throw UsageError("--threads: at most " + std::to_string(max_threads()) + " (4 x the " +
+                       std::to_string(max_threads() / 4) + " cores), got " + std::to_string(a.threads));
+    s.options.threads = a.threads;
+  }
   if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
   if (app.count("--tol")) s.options.magnetics.tol = a.tol;
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
@@ -142,7 +199,8 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   return s;
 }
 
-// Creates DIR (and parents) and checks that files can be written into it.
+// Creates DIR (and parents), checks that files can be written into it and deletes the
+// outputs of an earlier run there (only this program's own names, see is_output_name).
 void prepare_out_dir(const std::string& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
@@ -155,6 +213,12 @@ void prepare_out_dir(const std::string& dir) {
     if (!f || !(f << "ok") || !f.flush()) throw UsageError("--out " + dir + ": directory is not writable");
   }
   fs::remove(probe, ec);
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    if (!is_output_name(e.path().filename().string()) || e.is_directory(ec)) continue;
+    if (!fs::remove(e.path(), ec) && ec)
+      throw IoError("--out " + dir + ": cannot delete the old " + e.path().filename().string() + " (" + ec.message() + ")");
+  }
+  if (ec) throw IoError("--out " + dir + ": cannot list the directory (" + ec.message() + ")");
 }
 
 double median(std::vector<double> v) {
@@ -177,12 +241,34 @@ json vec3(const engine::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 // Per-frame output: states.csv and moments.csv rows, and the series of summary.json.
 class Recorder {
  public:
-  Recorder(const std::string& dir, const engine::Simulation& sim) : sim_(sim) {
-    states_ = std::fopen((fs::path(dir) / "states.csv").c_str(), "w");
-    moments_ = std::fopen((fs::path(dir) / "moments.csv").c_str(), "w");
-    if (!states_ || !moments_) throw UsageError("--out " + dir + ": cannot create states.csv / moments.csv");
+  Recorder(const std::string& dir, const engine::Simulation& sim)
+      : sim_(sim), states_path_((fs::path(dir) / "states.csv").string()),
+        moments_path_((fs::path(dir) / "moments.csv").string()) {
+    states_ = std::fopen(states_path_.c_str(), "w");
+    if (!states_) throw IoError("cannot create " + states_path_ + " (" + errno_text() + ")");
+    moments_ = std::fopen(moments_path_.c_str(), "w");
+    if (!moments_) throw IoError("cannot create " + moments_path_ + " (" + errno_text() + ")");
     std::fprintf(states_, "frame,time,body,name,x,y,z,qw,qx,qy,qz\n");
     std::fprintf(moments_, "frame,time,moment,body,x,y,z,Mx,My,Mz,M1x,M1y,M1z,M2x,M2y,M2z\n");
+    check();
+  }
+  /// Flushes and closes both files; throws IoError naming the file that failed.
+  void close() {
+    std::FILE* s = states_;
+    std::FILE* m = moments_;
+    states_ = moments_ = nullptr;
+    errno = 0;
+    const bool s_ok = std::fflush(s) == 0 && !std::ferror(s);
+    const std::string s_err = errno_text();
+    const bool s_closed = std::fclose(s) == 0;
+    if (!s_ok || !s_closed) {
+      std::fclose(m);
+      throw IoError("writing " + states_path_ + " failed (" + s_err + ")");
+    }
+    errno = 0;
+    const bool m_ok = std::fflush(m) == 0 && !std::ferror(m);
+    const std::string m_err = errno_text();
+    if (std::fclose(m) != 0 || !m_ok) throw IoError("writing " + moments_path_ + " failed (" + m_err + ")");
   }
   ~Recorder() {
     if (states_) std::fclose(states_);
@@ -204,7 +290,7 @@ class Recorder {
       const engine::Vec3& p = s.pos[b];
       const engine::Quat& q = s.quat[b];
       std::fprintf(states_, "%d,%.9g,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", f, t, b,
-                   m.body_name[b].c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
+                   csv_field(m.body_name[b]).c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
     }
     const mag::MomentSet& ms = sim_.moments();
     for (int j = 0; j < m.nmoment; ++j) {
@@ -224,13 +310,21 @@ class Recorder {
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
     series_["substeps"].push_back(sim_.last_profile().substeps);
+    check();
     return true;
   }
   int frames() const { return frames_; }
   const json& series() const { return series_; }
 
  private:
+  // a failed write (full disk …) sets the stream's error flag; stop at the first
+  void check() const {
+    if (std::ferror(states_)) throw IoError("writing " + states_path_ + " failed (" + errno_text() + ")");
+    if (std::ferror(moments_)) throw IoError("writing " + moments_path_ + " failed (" + errno_text() + ")");
+  }
+
   const engine::Simulation& sim_;
+  std::string states_path_, moments_path_;
   std::FILE* states_ = nullptr;
   std::FILE* moments_ = nullptr;
   long last_step_ = -1;
@@ -258,6 +352,7 @@ json options_json(const engine::Model& m) {
               {"bh_theta", d.field.bh_theta},
               {"bh_threshold", d.field.auto_threshold},
               {"threads", o.threads},
+              {"max_body_speed", o.max_body_speed},
               {"gravity", vec3(o.gravity)},
               {"ground", o.ground},
               {"friction", o.friction},
@@ -349,13 +444,33 @@ int run(const Args& a, const CLI::App& app) {
   const engine::Model& model = sim.model();
   const double dt = model.options.dt;
 
+  // the run's length, checked in double before any conversion to long
   long n_steps = a.steps;
   if (!app.count("--steps")) {
-    const double seconds = app.count("--seconds") ? a.seconds : scene.default_seconds;
-    n_steps = std::max(1L, std::lround(seconds / dt));
+    const bool flag = app.count("--seconds") > 0;
+    const double seconds = flag ? a.seconds : scene.default_seconds;
+    const std::string what = flag ? "--seconds " + fmt(seconds) : "the scene's default_seconds " + fmt(seconds);
+    if (seconds < dt * (1 - 1e-9))
+      throw UsageError(what + " is shorter than one rigid step (dt = " + fmt(dt) + " s)");
+    const double want = seconds / dt;
+    if (want > kMaxSteps)
+      throw UsageError(what + " at dt = " + fmt(dt) + " s is " + fmt(want) + " steps, more than the bound of " +
+                       fmt(kMaxSteps) + " steps");
+    n_steps = std::max(1L, std::lround(want));
   }
-  const long per_frame = std::max(1L, std::lround(1.0 / (a.fps * dt)));
+  if (static_cast<double>(n_steps) > kMaxSteps)
+    throw UsageError("--steps " + std::to_string(n_steps) + ": more than the bound of " + fmt(kMaxSteps) + " steps");
+  // a frame every per_frame steps; below one frame per run only the first and last are kept
+  const double frame_steps = 1.0 / (a.fps * dt);
+  const long per_frame = frame_steps >= static_cast<double>(n_steps) ? n_steps : std::max(1L, std::lround(frame_steps));
   const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
+  // summary.json must not overwrite the scene file it was made from (--out = its folder)
+  if (ends_with(a.scene, ".json"))
+    for (const char* n : kOutputNames) {
+      std::error_code ec;
+      if (fs::equivalent(fs::path(dir) / n, a.scene, ec))
+        throw UsageError("--out " + dir + ": the output " + n + " would overwrite the input scene file " + a.scene);
+    }
   prepare_out_dir(dir);
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
@@ -376,41 +491,51 @@ int run(const Args& a, const CLI::App& app) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   auto last_report = t0;
-  if (rec.frame()) painter.draw(sim);
-  for (long k = 0; k < n_steps; ++k) {
-    try {
-      sim.step();
-    } catch (const engine::SimulationError& e) {
-      error = e.what();
-      break;
+  std::string io_error;  // the first failed write; the run stops there
+  try {
+    if (rec.frame()) painter.draw(sim);
+    for (long k = 0; k < n_steps; ++k) {
+      try {
+        sim.step();
+      } catch (const engine::SimulationError& e) {
+        error = e.what();
+        break;
+      }
+      const engine::StepProfile& p = sim.last_profile();
+      Ti.push_back(p.T_i);
+      Tf.push_back(p.T_f);
+      Tr.push_back(p.T_r);
+      collide.push_back(p.collide_ms);
+      quickstep.push_back(p.quickstep_ms);
+      total.push_back(p.total_ms);
+      iters.push_back(p.iterations);
+      cap_hits += p.cap_hit ? 1 : 0;
+      substeps.push_back(p.substeps);
+      if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
+      const auto now = clock::now();
+      if (now - last_report >= std::chrono::seconds(2)) {
+        last_report = now;
+        std::fprintf(stderr,
+                     "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
+                     "iterations %d%s\n",
+                     scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
+                     std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
+                     p.cap_hit ? " (cap)" : "");
+      }
     }
-    const engine::StepProfile& p = sim.last_profile();
-    Ti.push_back(p.T_i);
-    Tf.push_back(p.T_f);
-    Tr.push_back(p.T_r);
-    collide.push_back(p.collide_ms);
-    quickstep.push_back(p.quickstep_ms);
-    total.push_back(p.total_ms);
-    iters.push_back(p.iterations);
-    cap_hits += p.cap_hit ? 1 : 0;
-    substeps.push_back(p.substeps);
-    if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
-    const auto now = clock::now();
-    if (now - last_report >= std::chrono::seconds(2)) {
-      last_report = now;
-      std::fprintf(stderr,
-                   "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
-                   "iterations %d%s\n",
-                   scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
-                   std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
-                   p.cap_hit ? " (cap)" : "");
-    }
+    if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
+  } catch (const IoError& e) {
+    io_error = e.what();
   }
-  if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
   try {
     painter.finish();
   } catch (const std::exception& e) {
-    if (error.empty()) error = std::string("writing frames: ") + e.what();
+    if (io_error.empty()) io_error = std::string("writing frames: ") + e.what();
+  }
+  try {
+    rec.close();
+  } catch (const IoError& e) {
+    if (io_error.empty()) io_error = e.what();
   }
   const double wall = std::chrono::duration<double>(clock::now() - t0).count();
 
@@ -466,18 +591,32 @@ int run(const Args& a, const CLI::App& app) {
         {"contacts", fin.contacts}}},
       {"series", rec.series()},
       {"state_hash", hash},
-      {"error", error.empty() ? json(nullptr) : json(error)}};
+      {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};
 
+  // written to a temporary name and renamed when complete: a full disk leaves no
+  // summary.json that looks valid
   const fs::path path = fs::path(dir) / "summary.json";
-  std::ofstream out(path);
-  out << summary.dump(1) << '\n';
-  if (!out) {
-    std::fprintf(stderr, "error: cannot write %s\n", path.c_str());
-    return 1;
+  const fs::path tmp = fs::path(dir) / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << summary.dump(1) << '\n';
+    out.close();
+    std::error_code ec;
+    if (!out || (fs::rename(tmp, path, ec), ec)) {
+      const std::string why = ec ? ec.message() : errno_text();
+      fs::remove(tmp, ec);
+      std::fprintf(stderr, "error: cannot write %s (%s)%s%s\n", path.c_str(), why.c_str(),
+                   io_error.empty() ? "" : "; before that: ", io_error.c_str());
+      return kIoError;
+    }
+  }
+  if (!io_error.empty()) {
+    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", io_error.c_str(), path.c_str());
+    return kIoError;
   }
   if (!error.empty()) {
     std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
-    return 1;
+    return kRunFailed;
   }
   const mag::FieldOptions& fo = model.options.magnetics.field;
   std::fprintf(stderr,
@@ -486,8 +625,32 @@ int run(const Args& a, const CLI::App& app) {
                scene.name.c_str(), method.c_str(), sim.steps(), sim.time(), wall, median(Ti), median(Tf),
                median(Tr), median(total), mag::field_solver_name(mag::resolve_solver(fo, static_cast<std::size_t>(model.nmoment))),
                mag::field_solver_name(fo.solver), model.nmoment, path.c_str());
-  return 0;
+  return kOk;
 }
+
+// --seconds / --fps: CLI::PositiveNumber lets nan and inf through
+const auto kFinitePositive = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        const double x = std::stod(v);
+        if (std::isfinite(x) && x > 0) return {};
+      } catch (const std::exception&) {
+      }
+      return "must be a finite number > 0, got " + v;
+    },
+    "POSITIVE");
+
+// --width / --height: H.264 (tools/make_video.sh) needs even frame sizes
+const auto kEven = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        if (std::stol(v) % 2 == 0) return {};
+      } catch (const std::exception&) {
+        return {};  // the Range check names it
+      }
+      return "must be even (H.264), got " + v;
+    },
+    "EVEN");
 
 }  // namespace
 
@@ -499,19 +662,19 @@ int main(int argc, char** argv) {
   app.add_option("--method", a.method, "ours-realigned | ours | kim2018 | damping-llg | anderson | exact (default: the scene's, ours-realigned)")
       ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "anderson", "exact"}));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
-                      ->check(CLI::PositiveNumber);
-  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, 2000000000L));
+                      ->check(kFinitePositive);
+  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, static_cast<long>(kMaxSteps)));
   seconds->excludes(steps);
   steps->excludes(seconds);
   app.add_option("--out", a.out, "output directory (default: out/<scene>_<method>)");
-  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60), in [0.001, 1e9]")
+      ->check(kFinitePositive & CLI::Range(1e-3, 1e9));
   app.add_flag("--no-render", a.no_render, "do not render frames");
-  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192))->capture_default_str();
-  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192))->capture_default_str();
+  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
   app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(CLI::Range(1, 4))->capture_default_str();
   app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
-  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics")->check(CLI::Range(1, 1000000000));
+  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores")->check(CLI::Range(1, 1000000000));
   app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(CLI::Range(1, 1000000000));
   app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(CLI::PositiveNumber);
   app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
@@ -546,29 +709,39 @@ int main(int argc, char** argv) {
               "--bh-threshold moments on");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
 
+  app.footer("Exit codes: 0 done, 1 bad usage, flags or scene, 2 the simulation failed (summary.json "
+             "holds the error), 3 an output file could not be written.\nRuns longer than 1e7 rigid "
+             "steps are refused.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
-    return 2;
+    return kBadInput;
   }
   if (a.list) {
     for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
-    return 0;
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      std::fprintf(stderr, "error: writing the list to stdout failed (%s)\n", errno_text().c_str());
+      return kIoError;
+    }
+    return kOk;
   }
   if (a.scene.empty()) {
     std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
-    return 2;
+    return kBadInput;
   }
   try {
     return run(a, app);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+    return kBadInput;
+  } catch (const IoError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kIoError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    return kRunFailed;
   }
 }

@@ -1,15 +1,22 @@
 // tools/magsolve.cpp — the magnetics core as a command-line tool: solves one configuration
 // of moments and prints, per moment, M, H, the Zeeman force and the classic force, plus the
 // iterations taken, whether the dynamics converged and e_M against the ground truth (eq. 12).
+//
+// Exit codes (the same in magsim-scene): 0 done, 1 bad input or flags, 2 the solve failed
+// (non-finite solution), 3 I/O error (the output could not be written).
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
+#include "scenes/json_unique_keys.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -20,6 +27,8 @@ namespace mag = magsim::mag;
 using nlohmann::json;
 
 namespace {
+
+enum Exit { kOk = 0, kBadInput = 1, kRunFailed = 2, kIoError = 3 };
 
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -98,9 +107,33 @@ mag::MomentSet parse_case(const json& doc, double softening) {
 
 json vec_json(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-}  // namespace
+// The whole file as text. A directory opens as an ifstream on Linux and throws
+// std::ios_failure on the first read, so it is refused by name first.
+std::string read_text(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError("is a directory, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot read file");
+  std::ostringstream text;
+  try {
+    text << in.rdbuf();
+  } catch (const std::exception& e) {
+    throw InputError(std::string("cannot read file (") + e.what() + ")");
+  }
+  if (in.bad()) throw InputError("cannot read file");
+  return text.str();
+}
 
-int main(int argc, char** argv) {
+// The Newton reference holds the dense 3N x 3N interaction matrix T, the Jacobian and its
+// LU factors (N induced moments): three matrices of doubles. Above this bound magsolve
+// refuses up front instead of dying in bad_alloc or paging for hours.
+constexpr double kReferenceBytesMax = 2.0 * 1024 * 1024 * 1024;
+double reference_bytes(std::size_t induced) {
+  const double n3 = 3.0 * static_cast<double>(induced);
+  return 3.0 * n3 * n3 * sizeof(double);
+}
+
+int run(int argc, char** argv) {
   CLI::App app{
       "magsolve — solve one configuration of induced and permanent magnetic moments.\n"
       "Prints per moment M (A/m), H (A/m), the Zeeman force F (eq. 4) and the classic force\n"
@@ -122,13 +155,24 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  app.footer(
+      "Exit codes: 0 done, 1 bad input or flags, 2 the solve failed, 3 the output could not be "
+      "written.\nThe Newton reference needs three dense 3N x 3N matrices for N induced moments; "
+      "above 2 GiB (N > 3153) magsolve refuses the case (exit 1).");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kBadInput;
+  }
 
   mag::DynamicsOptions opt;
   if (!mag::parse_method(method_name, &opt.method)) {
     std::fprintf(stderr, "magsolve: unknown method '%s' (ours, ours-realigned, kim2018, "
                          "damping-llg, exact, anderson)\n", method_name.c_str());
-    return 2;
+    return kBadInput;
   }
   opt.dt = dt;
   opt.tol = tol;
@@ -136,23 +180,36 @@ int main(int argc, char** argv) {
   opt.field.softening = softening;
   if (const std::string e = mag::validate(opt); !e.empty()) {
     std::fprintf(stderr, "magsolve: %s\n", e.c_str());
-    return 2;
+    return kBadInput;
   }
 
   mag::MomentSet set;
   try {
-    std::ifstream in(path);
-    if (!in) throw InputError("cannot read file");
+    const std::string text = read_text(path);
     json doc;
     try {
-      doc = json::parse(in);
+      doc = magsim::scenes::parse_unique_keys(text);
+    } catch (const magsim::scenes::DuplicateKeyError& e) {
+      throw InputError(e.what());
     } catch (const json::exception& e) {  // syntax errors and numbers out of range
       throw InputError(std::string("malformed JSON: ") + e.what());
     }
     set = parse_case(doc, softening);
+    std::size_t induced = 0;
+    for (std::size_t j = 0; j < set.size(); ++j) induced += set.kind[j] == mag::MomentKind::Induced;
+    if (reference_bytes(induced) > kReferenceBytesMax) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg,
+                    "%zu induced moments: the Newton reference needs three dense %zux%zu matrices "
+                    "(%.1f GiB), more than the %.0f GiB bound; use at most %zu induced moments",
+                    induced, 3 * induced, 3 * induced, reference_bytes(induced) / (1 << 30),
+                    kReferenceBytesMax / (1 << 30),
+                    static_cast<std::size_t>(std::sqrt(kReferenceBytesMax / (3.0 * 9 * sizeof(double)))));
+      throw InputError(msg);
+    }
   } catch (const InputError& e) {
     std::fprintf(stderr, "magsolve: %s: %s\n", path.c_str(), e.what());
-    return 1;
+    return kBadInput;
   }
 
   // ground truth of the method's curve
@@ -186,7 +243,7 @@ int main(int argc, char** argv) {
   if (!finite) {
     std::fprintf(stderr, "magsolve: %s: the solution is not finite (moments too close? try "
                          "--softening)\n", path.c_str());
-    return 1;
+    return kRunFailed;
   }
 
   if (format == "json") {
@@ -224,5 +281,25 @@ int main(int argc, char** argv) {
                   Fc[j].y(), Fc[j].z());
     }
   }
-  return 0;
+  // a full disk or a closed pipe must not pass as success: flush and check both streams
+  std::cout.flush();
+  const bool written = std::cout.good() && std::fflush(stdout) == 0 && !std::ferror(stdout);
+  if (!written) {
+    std::fprintf(stderr, "magsolve: writing the results to stdout failed (%s)\n",
+                 errno ? std::strerror(errno) : "stream error");
+    return kIoError;
+  }
+  return kOk;
+}
+
+}  // namespace
+
+// Anything not caught above (e.g. std::bad_alloc) ends in one line and exit 2, not abort().
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "magsolve: error: %s\n", e.what());
+    return kRunFailed;
+  }
 }

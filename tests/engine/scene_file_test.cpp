@@ -14,6 +14,15 @@ namespace {
 
 const std::string kExample = std::string(MAGSIM_SOURCE_DIR) + "/scenes/examples/two_balls.json";
 
+std::string error_of_origin(const std::string& text, const std::string& origin) {
+  try {
+    scenes::parse_scene_json(text, origin);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 std::string error_of(const std::string& text) {
   try {
     scenes::parse_scene_json(text, "scene.json");
@@ -146,4 +155,29 @@ TEST_CASE("scene_file: the field solver options are read and checked", "[scene_f
   CHECK_THAT(error_of(R"({"options": {"bh_theta": 1.5}, "bodies": []})"), Contains("options.bh_theta: must be in (0, 1]"));
   CHECK_THAT(error_of(R"({"options": {"bh_threshold": -1}, "bodies": []})"), Contains("options.bh_threshold: must be in"));
   CHECK_THAT(error_of(R"({"options": {"bh_threshold": 2.5}, "bodies": []})"), Contains("options.bh_threshold: must be an integer"));
+}
+
+TEST_CASE("scene_file: a key given twice is an error naming the key and its path (#13)", "[scene_file][reliability]") {
+  CHECK_THAT(error_of(R"({"bodies": [{"name": "b", "shapes": [{"kind": "sphere", "size": 0.005, "size": 0.01}]}]})"),
+             Contains("scene.json: bodies[0].shapes[0].size: duplicate key"));
+  CHECK_THAT(error_of(R"({"bodies": [], "bodies": []})"), Contains("scene.json: bodies: duplicate key"));
+  CHECK_THAT(error_of(R"({"options": {"dt": 1e-3, "magnetics": {"tol": 1e-4, "tol": 1e-5}}, "bodies": []})"),
+             Contains("options.magnetics.tol: duplicate key"));
+  // the same key in two sibling objects is fine
+  CHECK(error_of(R"({"bodies": [{"name": "a", "type": "static"}, {"name": "b", "type": "static"}]})").empty());
+}
+
+TEST_CASE("scene_file: a permanent moment needs \"moment\" (#13)", "[scene_file][reliability]") {
+  CHECK_THAT(error_of(R"({"bodies": [{"type": "static", "moments": [{"permanent": true, "volume": 1e-6}]}]})"),
+             Contains("bodies[0].moments[0].moment: required for a permanent moment"));
+}
+
+TEST_CASE("scene_file: a scene name that is not a plain folder name is refused (#13)", "[scene_file][reliability]") {
+  for (const char* name : {R"("a/b")", R"("..")", R"("../up")", R"("tab\there")", R"("nl\n")", R"("")"})
+    CHECK_THAT(error_of(std::string("{\"name\": ") + name + ", \"bodies\": []}"), Contains("scene.json: name: the scene name"));
+  // invalid UTF-8 in the text: the JSON parser refuses it
+  CHECK_THAT(error_of("{\"name\": \"bad\xff\", \"bodies\": []}"), Contains("scene.json"));
+  // ... and in the file name a default name comes from
+  CHECK_THAT(error_of_origin("{\"bodies\": []}", "dir/bad\xc3.json"), Contains("the scene name must be valid UTF-8"));
+  CHECK(error_of(R"({"name": "Kugeln über dem Magnet", "bodies": []})").empty());
 }

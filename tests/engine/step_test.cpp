@@ -72,6 +72,9 @@ TEST_CASE("step: same scene and options give the same state hash", "[step][deter
   SECTION("a changed rigid option changes it") {
     SceneDesc s2 = s;
     s2.options.erp = 0.25;
+    // erp 0.25 flings ball_3 to 1160 m/s at step 94: a blow-up the speed guard stops; this
+    // section compares hashes only, so the guard is off here
+    s2.options.max_body_speed = 0;
     engine::Simulation c(s2);
     c.run(200);
     CHECK(c.state_hash() != a.state_hash());
