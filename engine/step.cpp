@@ -5,6 +5,7 @@
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
 //   then read back, check for non-finite values, commit       safety.cpp
+//   (and the energy audit of the step, committed with it)     energy.cpp
 //
 // The step works on ws_.next and swaps it into state_ only when every check passes, so
 // state_ is always the last good state; on failure ODE and the moments are rewound to it.
@@ -25,6 +26,9 @@ void Simulation::step() {
   ScopedTimer total(&prof.total_ms);
   const long n = state_.step + 1;  // the step being taken, as named in errors
   omp_set_num_threads(omp_threads_);  // per calling thread; several Simulations may differ
+
+  // energy audit (energy.hpp) of this step, committed with the state
+  EnergyAudit audit = begin_audit_step(energy_);
 
   try {
     // (1) ODE takes the state; moments take world positions (and permanent moments their
@@ -82,6 +86,10 @@ void Simulation::step() {
       store_magnetization(moments_, &next);
       next.step = n;
       check_bodies(m, next, n);
+      // energy audit: the work of this ODE step (O(bodies)); U_mag from the forces' field
+      audit_substep(m, state_, next, ws_.body_force, ws_.body_torque, m.options.dt, &audit);
+      audit.magnetic_energy = magnetic_energy(moments_, ws_.mag.H);
+      energy_ = audit;
       std::swap(state_, next);
       place_moments(m, state_, &moments_);  // moments() follows the new poses
     }

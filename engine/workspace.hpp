@@ -14,6 +14,9 @@ struct Workspace {
   std::vector<mag::Vec3> F;       ///< (nmoment) magnetic force on each moment (N)
   std::vector<mag::Vec3> tau;     ///< (nmoment) magnetic torque on each moment (N·m)
   std::vector<Vec3> body_force;   ///< (nbody) net magnetic force on each body this step (N)
+  /// (nbody) net magnetic torque on each body about its COM this step (N·m): the lever arms
+  /// of its moments' forces and the torques of its permanent moments (energy audit)
+  std::vector<Vec3> body_torque;
   /// (nbody) net magnetic force when the body was last awake (auto-disable wake-up)
   std::vector<Vec3> body_force_awake;
   State next;                     ///< the state being computed; swapped in when it checks out

@@ -1,7 +1,8 @@
 // tools/magsim_scene.cpp — runs one scene (from the registry or a JSON file) with one
 // method and writes what happened: summary.json (options, timings T_i/T_f/T_r, iteration
-// statistics, final metrics, per-frame series, state hash, error), states.csv (body poses
-// per frame) and moments.csv (magnetizations per frame).
+// statistics, final metrics — attached, held, escaped beyond escape_radius, … —, the
+// energy audit, per-frame series, state hash, error), states.csv (body poses per frame) and
+// moments.csv (magnetizations per frame).
 //
 //   magsim-scene balls_up --method kim2018 --seconds 2
 //   magsim-scene scenes/examples/two_balls.json --steps 500 --out out/two
@@ -201,9 +202,23 @@ class Recorder {
     series_["bounding_radius"].push_back(x.bounding_radius);
     series_["magnet_radius"].push_back(x.magnet_radius);
     series_["attached"].push_back(x.attached);
+    series_["held"].push_back(x.held);
+    series_["escaped"].push_back(x.escaped);
     series_["iterations"].push_back(x.iterations);
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
+    // the energy audit (engine/energy.hpp): state functions and cumulative work (J), and the
+    // last step's magnetic and contact work (J per step)
+    const engine::EnergyAudit& e = sim_.energy();
+    series_["energy_kinetic"].push_back(e.kinetic);
+    series_["energy_gravitational"].push_back(e.gravitational);
+    series_["energy_magnetic"].push_back(e.magnetic_energy);
+    series_["energy_magnetic_work"].push_back(e.total.magnetic_work);
+    series_["energy_contact_work"].push_back(e.total.contact_work);
+    series_["energy_gravity_work"].push_back(e.total.gravity_work);
+    series_["energy_gravity_drift"].push_back(e.total.gravity_drift);
+    series_["energy_step_magnetic_work"].push_back(e.last.magnetic_work);
+    series_["energy_step_contact_work"].push_back(e.last.contact_work);
     return true;
   }
   int frames() const { return frames_; }
@@ -217,6 +232,29 @@ class Recorder {
   int frames_ = 0;
   json series_ = json::object();
 };
+
+json energy_flow_json(const engine::EnergyFlow& f) {
+  return json{{"kinetic_change", f.kinetic_change},
+              {"gravitational_change", f.gravitational_change},
+              {"magnetic_work", f.magnetic_work},
+              {"gravity_work", f.gravity_work},
+              {"contact_work", f.contact_work},
+              {"gravity_drift", f.gravity_drift}};
+}
+
+// summary.json "energy": the audit at the end of the run (J); "last_step" = the increments
+// of the final step. ΔK + ΔU_g = magnetic_work + contact_work − gravity_drift.
+json energy_json(const engine::EnergyAudit& e) {
+  json j = energy_flow_json(e.total);
+  j["kinetic"] = e.kinetic;
+  j["gravitational"] = e.gravitational;
+  j["initial_kinetic"] = e.initial_kinetic;
+  j["initial_gravitational"] = e.initial_gravitational;
+  j["magnetic_energy"] = e.magnetic_energy;
+  j["substeps"] = e.substeps;
+  j["last_step"] = energy_flow_json(e.last);
+  return j;
+}
 
 json options_json(const engine::Model& m) {
   const engine::SimOptions& o = m.options;
@@ -397,6 +435,7 @@ int run(const Args& a, const CLI::App& app) {
       {"method", method},
       {"options", options_json(model)},
       {"params", {{"count", a.count}, {"strength", app.count("--strength") ? a.strength : 1.0}}},
+      {"escape_radius", model.escape_radius},
       {"bodies", model.nbody},
       {"dynamic_bodies", model.dynamic_bodies.size()},
       {"moments", model.nmoment},
@@ -427,8 +466,11 @@ int run(const Args& a, const CLI::App& app) {
         {"bounding_radius", fin.bounding_radius},
         {"magnet_radius", fin.magnet_radius},
         {"attached", fin.attached},
+        {"held", fin.held},
+        {"escaped", fin.escaped},
         {"momentum", vec3(fin.momentum)},
         {"contacts", fin.contacts}}},
+      {"energy", energy_json(sim.energy())},
       {"series", rec.series()},
       {"state_hash", hash},
       {"error", error.empty() ? json(nullptr) : json(error)}};
