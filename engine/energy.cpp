@@ -5,6 +5,8 @@
 #include "engine/metrics.hpp"
 #include "magnetics/types.hpp"
 
+#include <algorithm>
+
 namespace magsim::engine {
 
 namespace {
@@ -29,6 +31,7 @@ void add(const EnergyFlow& d, EnergyFlow* to) {
   to->gravity_work += d.gravity_work;
   to->contact_work += d.contact_work;
   to->gravity_drift += d.gravity_drift;
+  to->contact_work_in += d.contact_work_in;
 }
 
 }  // namespace
@@ -37,13 +40,14 @@ EnergyAudit start_energy_audit(const Model& m, const State& s) {
   EnergyAudit a;
   a.kinetic = a.initial_kinetic = total_kinetic_energy(m, s);
   a.gravitational = a.initial_gravitational = gravitational_energy(m, s);
+  a.body_magnetic_work.assign(m.nbody, 0.0);
+  a.body_contact_work.assign(m.nbody, 0.0);
   return a;
 }
 
-EnergyAudit begin_audit_step(const EnergyAudit& a) {
-  EnergyAudit next = a;
-  next.last = EnergyFlow{};
-  return next;
+void begin_audit_step(const EnergyAudit& a, EnergyAudit* next) {
+  *next = a;  // vectors: copy-assignment into the same sizes, no allocation once warm
+  next->last = EnergyFlow{};
 }
 
 void audit_substep(const Model& m, const State& before, const State& after,
@@ -54,17 +58,27 @@ void audit_substep(const Model& m, const State& before, const State& after,
   double k_before = 0.0, k_after = 0.0, u_before = 0.0, u_after = 0.0;
   for (int b : m.dynamic_bodies) {
     const double mass = m.body_mass[b];
-    k_before += kinetic_energy(m, before, b);
-    k_after += kinetic_energy(m, after, b);
+    const double kb = kinetic_energy(m, before, b), ka = kinetic_energy(m, after, b);
+    k_before += kb;
+    k_after += ka;
     u_before -= mass * g.dot(before.pos[b]);
     u_after -= mass * g.dot(after.pos[b]);
+    double w_mag = 0.0, w_g = 0.0;
     // a body asleep throughout the step was given no force by ODE (nor gravity)
-    if (!before.enabled[b] && !after.enabled[b]) continue;
-    // work of a constant force over the step: F · ½(v⁻ + v⁺) h, exact for ODE's impulse
-    const Vec3 v_mid = 0.5 * (before.vel[b] + after.vel[b]);
-    const Vec3 w_mid = 0.5 * (before.angvel[b] + after.angvel[b]);
-    d.magnetic_work += (body_force[b].dot(v_mid) + body_torque[b].dot(w_mid)) * h;
-    d.gravity_work += mass * g.dot(v_mid) * h;
+    if (before.enabled[b] || after.enabled[b]) {
+      // work of a constant force over the step: F · ½(v⁻ + v⁺) h, exact for ODE's impulse
+      const Vec3 v_mid = 0.5 * (before.vel[b] + after.vel[b]);
+      const Vec3 w_mid = 0.5 * (before.angvel[b] + after.angvel[b]);
+      w_mag = (body_force[b].dot(v_mid) + body_torque[b].dot(w_mid)) * h;
+      w_g = mass * g.dot(v_mid) * h;
+    }
+    // the body's own books: its contact work is its residual
+    const double w_c = (ka - kb) - w_mag - w_g;
+    d.magnetic_work += w_mag;
+    d.gravity_work += w_g;
+    d.contact_work_in += std::max(0.0, w_c);
+    acc->body_magnetic_work[b] += w_mag;
+    acc->body_contact_work[b] += w_c;
   }
   d.kinetic_change = k_after - k_before;
   d.gravitational_change = u_after - u_before;

@@ -31,8 +31,9 @@
 // field either; so W_mag — the work the engine actually did — is the audit's main quantity,
 // and `magnetic_energy` (below) is a reference only.
 //
-// Cost: O(bodies) per step (two kinetic energies and a few dot products per body); the
-// magnetic energy reuses the field the force stage evaluated (O(moments), no field sum).
+// Cost: O(bodies) per step (two kinetic energies and a few dot products per body), no
+// allocation; the magnetic energy reuses the field the force stage evaluated (O(moments),
+// no field sum).
 #pragma once
 
 #include "engine/state.hpp"
@@ -51,6 +52,10 @@ struct EnergyFlow {
   double gravity_work = 0.0;          ///< W_g = Σ m g·½(v⁻ + v⁺) h (J)
   double contact_work = 0.0;          ///< W_c = ΔK − W_mag − W_g: contacts, the residual (J)
   double gravity_drift = 0.0;         ///< D = −ΔU_g − W_g: semi-implicit Euler's drift (J)
+  /// Σ over bodies and ODE steps of max(0, W_c,b): what the contacts gave the bodies they
+  /// sped up (J, ≥ 0). Includes transfers (a ball hitting a resting one), so it bounds the
+  /// contacts' injection from above; contact_work_in − contact_work = what they took.
+  double contact_work_in = 0.0;
 };
 
 /// The audit of a run: state functions now, and the work done since t = 0.
@@ -66,14 +71,17 @@ struct EnergyAudit {
   EnergyFlow total;  ///< sums since the start of the audit
   EnergyFlow last;   ///< the last rigid step (the sum over its ODE sub-steps)
   long substeps = 0;  ///< ODE steps audited
+  /// (nbody) per body since the start: magnetic work and contact work (J); 0 for bodies
+  /// that are not dynamic. Where the energy of the bodies that flew off came from.
+  std::vector<double> body_magnetic_work, body_contact_work;
 };
 
 /// An audit starting at state s: K and U_g of s, nothing done yet.
 EnergyAudit start_energy_audit(const Model& model, const State& s);
 
-/// A copy of `a` for the next rigid step: `last` emptied, totals kept. The step audits
-/// into the copy and commits it with the state (a failed step leaves the audit alone).
-EnergyAudit begin_audit_step(const EnergyAudit& a);
+/// *next = a with `last` emptied, totals kept: the next rigid step audits into *next and
+/// commits it with the state (a failed step leaves the audit alone). Reuses next's storage.
+void begin_audit_step(const EnergyAudit& a, EnergyAudit* next);
 
 /// Adds one ODE step of length h from `before` to `after` to acc->total and acc->last and
 /// sets acc->kinetic and acc->gravitational to those of `after`. body_force and body_torque

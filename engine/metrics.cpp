@@ -75,8 +75,9 @@ int count_held(const Model& m, const State& s) {
 // Dynamic non-magnet bodies farther than R_esc from c, the centroid of the magnet bodies:
 // |x − c| over (x, y) only when there is gravity (a ball that fell spreads out on the
 // floor; height says nothing about escape), over (x, y, z) in zero gravity.
-int count_escaped(const Model& m, const State& s) {
-  if (!(m.escape_radius > 0)) return 0;
+std::vector<int> find_escaped(const Model& m, const State& s) {
+  std::vector<int> escaped;
+  if (!(m.escape_radius > 0)) return escaped;
   Vec3 c = Vec3::Zero();
   int magnets = 0;
   for (int b = 0; b < m.nbody; ++b)
@@ -84,20 +85,21 @@ int count_escaped(const Model& m, const State& s) {
       c += s.pos[b];
       ++magnets;
     }
-  if (magnets == 0) return 0;
+  if (magnets == 0) return escaped;
   c /= static_cast<double>(magnets);
   const bool horizontal = m.options.gravity.norm() != 0.0;
-  int escaped = 0;
   for (int b : m.dynamic_bodies) {
     if (m.body_magnet[b]) continue;
     Vec3 d = s.pos[b] - c;
     if (horizontal) d.z() = 0.0;
-    if (d.norm() > m.escape_radius) ++escaped;
+    if (d.norm() > m.escape_radius) escaped.push_back(b);
   }
   return escaped;
 }
 
 }  // namespace
+
+std::vector<int> escaped_bodies(const Model& m, const State& s) { return find_escaped(m, s); }
 
 double kinetic_energy(const Model& m, const State& s, int b) {
   // E = ½ m |v|² + ½ ωᵀ (R I Rᵀ) ω
@@ -135,7 +137,7 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
   }
   r.attached = count_attached(m, s);
   r.held = count_held(m, s);
-  r.escaped = count_escaped(m, s);
+  r.escaped = static_cast<int>(find_escaped(m, s).size());
   return r;
 }
 

@@ -38,6 +38,9 @@ struct Metrics {
 
 Metrics compute_metrics(const Model& model, const State& s, const StepProfile& last);
 
+/// The bodies Metrics::escaped counts, ascending (empty when escape_radius is 0).
+std::vector<int> escaped_bodies(const Model& model, const State& s);
+
 /// Kinetic energy of one body, ½ m |v|² + ½ ωᵀ I_world ω (J); the one formula of the
 /// metrics and the energy audit.
 double kinetic_energy(const Model& model, const State& s, int body);

@@ -28,7 +28,7 @@ void Simulation::step() {
   omp_set_num_threads(omp_threads_);  // per calling thread; several Simulations may differ
 
   // energy audit (energy.hpp) of this step, committed with the state
-  EnergyAudit audit = begin_audit_step(energy_);
+  begin_audit_step(energy_, &ws_.audit);
 
   try {
     // (1) ODE takes the state; moments take world positions (and permanent moments their
@@ -87,9 +87,9 @@ void Simulation::step() {
       next.step = n;
       check_bodies(m, next, n);
       // energy audit: the work of this ODE step (O(bodies)); U_mag from the forces' field
-      audit_substep(m, state_, next, ws_.body_force, ws_.body_torque, m.options.dt, &audit);
-      audit.magnetic_energy = magnetic_energy(moments_, ws_.mag.H);
-      energy_ = audit;
+      audit_substep(m, state_, next, ws_.body_force, ws_.body_torque, m.options.dt, &ws_.audit);
+      ws_.audit.magnetic_energy = magnetic_energy(moments_, ws_.mag.H);
+      std::swap(energy_, ws_.audit);
       std::swap(state_, next);
       place_moments(m, state_, &moments_);  // moments() follows the new poses
     }

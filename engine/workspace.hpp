@@ -2,6 +2,7 @@
 // Sized once; a warm step allocates nothing.
 #pragma once
 
+#include "engine/energy.hpp"
 #include "engine/state.hpp"
 #include "magnetics/magnetization.hpp"
 
@@ -20,6 +21,7 @@ struct Workspace {
   /// (nbody) net magnetic force when the body was last awake (auto-disable wake-up)
   std::vector<Vec3> body_force_awake;
   State next;                     ///< the state being computed; swapped in when it checks out
+  EnergyAudit audit;              ///< the energy audit being computed, committed with next
 };
 
 }  // namespace magsim::engine

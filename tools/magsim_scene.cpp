@@ -239,13 +239,25 @@ json energy_flow_json(const engine::EnergyFlow& f) {
               {"magnetic_work", f.magnetic_work},
               {"gravity_work", f.gravity_work},
               {"contact_work", f.contact_work},
-              {"gravity_drift", f.gravity_drift}};
+              {"gravity_drift", f.gravity_drift},
+              {"contact_work_in", f.contact_work_in}};
 }
 
 // summary.json "energy": the audit at the end of the run (J); "last_step" = the increments
-// of the final step. ΔK + ΔU_g = magnetic_work + contact_work − gravity_drift.
-json energy_json(const engine::EnergyAudit& e) {
+// of the final step; "escaped_bodies" = the escaped bodies' kinetic energy now and the
+// magnetic and contact work done on them since t = 0.
+// ΔK + ΔU_g = magnetic_work + contact_work − gravity_drift.
+json energy_json(const engine::Simulation& sim) {
+  const engine::EnergyAudit& e = sim.energy();
   json j = energy_flow_json(e.total);
+  double k = 0.0, w_mag = 0.0, w_c = 0.0;
+  const std::vector<int> escaped = engine::escaped_bodies(sim.model(), sim.state());
+  for (int b : escaped) {
+    k += engine::kinetic_energy(sim.model(), sim.state(), b);
+    w_mag += e.body_magnetic_work[b];
+    w_c += e.body_contact_work[b];
+  }
+  j["escaped_bodies"] = {{"count", escaped.size()}, {"kinetic", k}, {"magnetic_work", w_mag}, {"contact_work", w_c}};
   j["kinetic"] = e.kinetic;
   j["gravitational"] = e.gravitational;
   j["initial_kinetic"] = e.initial_kinetic;
@@ -470,7 +482,7 @@ int run(const Args& a, const CLI::App& app) {
         {"escaped", fin.escaped},
         {"momentum", vec3(fin.momentum)},
         {"contacts", fin.contacts}}},
-      {"energy", energy_json(sim.energy())},
+      {"energy", energy_json(sim)},
       {"series", rec.series()},
       {"state_hash", hash},
       {"error", error.empty() ? json(nullptr) : json(error)}};

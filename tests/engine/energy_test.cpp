@@ -99,6 +99,9 @@ TEST_CASE("energy: an overlap pushed out by ERP is booked as contact work", "[en
   CHECK(e.kinetic > 0.5 * K);
   CHECK(e.total.contact_work > 0.5 * K);
   CHECK(e.total.contact_work == Approx(e.kinetic - e.total.gravity_work).epsilon(1e-9));
+  // one body: its own books are the totals, and all of the contact work went in
+  CHECK(e.body_contact_work[0] == Approx(e.total.contact_work).epsilon(1e-12));
+  CHECK(e.total.contact_work_in == Approx(e.total.contact_work).epsilon(1e-12));
 }
 
 TEST_CASE("energy: the magnetic work on a ball pulled toward a magnet is its ΔK", "[energy]") {
@@ -116,6 +119,8 @@ TEST_CASE("energy: the magnetic work on a ball pulled toward a magnet is its ΔK
   CHECK(std::abs(e.total.contact_work) < 1e-6 * e.kinetic);
   CHECK(e.total.gravity_work == 0.0);
   CHECK(e.last.magnetic_work > 0.0);  // still accelerating toward the magnet
+  CHECK(e.body_magnetic_work[1] == Approx(e.total.magnetic_work).epsilon(1e-12));
+  CHECK(e.body_magnetic_work[0] == 0.0);  // the static magnet
 }
 
 TEST_CASE("energy: magnetic torques are counted (an off-centre dumbbell turns)", "[energy]") {

@@ -51,6 +51,8 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
   CHECK(std::abs(balance) <= 1e-12 + 1e-9 * std::abs(e["magnetic_work"].get<double>()));
   CHECK(e["kinetic"].get<double>() == Approx(j["final"]["kinetic_energy"].get<double>()).epsilon(1e-12));
   CHECK(e["magnetic_energy"].get<double>() < 0);  // iron drawn to the magnet: bound
+  CHECK(e["escaped_bodies"]["count"] == j["final"]["escaped"]);
+  CHECK(e["contact_work_in"].get<double>() >= 0);
   for (const char* k : {"energy_kinetic", "energy_gravitational", "energy_magnetic_work",
                         "energy_contact_work", "energy_magnetic"})
     CHECK(j["series"][k].size() == j["series"]["time"].size());
