@@ -42,6 +42,8 @@ EnergyAudit start_energy_audit(const Model& m, const State& s) {
   a.gravitational = a.initial_gravitational = gravitational_energy(m, s);
   a.body_magnetic_work.assign(m.nbody, 0.0);
   a.body_contact_work.assign(m.nbody, 0.0);
+  a.body_magnetic_work_in.assign(m.nbody, 0.0);
+  a.body_contact_work_in.assign(m.nbody, 0.0);
   return a;
 }
 
@@ -79,6 +81,8 @@ void audit_substep(const Model& m, const State& before, const State& after,
     d.contact_work_in += std::max(0.0, w_c);
     acc->body_magnetic_work[b] += w_mag;
     acc->body_contact_work[b] += w_c;
+    acc->body_magnetic_work_in[b] += std::max(0.0, w_mag);
+    acc->body_contact_work_in[b] += std::max(0.0, w_c);
   }
   d.kinetic_change = k_after - k_before;
   d.gravitational_change = u_after - u_before;

@@ -74,6 +74,9 @@ struct EnergyAudit {
   /// (nbody) per body since the start: magnetic work and contact work (J); 0 for bodies
   /// that are not dynamic. Where the energy of the bodies that flew off came from.
   std::vector<double> body_magnetic_work, body_contact_work;
+  /// (nbody) the same summed over the steps where it was positive (J, ≥ 0): how much each
+  /// channel ever gave the body, whatever it took back at other steps
+  std::vector<double> body_magnetic_work_in, body_contact_work_in;
 };
 
 /// An audit starting at state s: K and U_g of s, nothing done yet.

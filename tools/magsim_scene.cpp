@@ -245,19 +245,23 @@ json energy_flow_json(const engine::EnergyFlow& f) {
 
 // summary.json "energy": the audit at the end of the run (J); "last_step" = the increments
 // of the final step; "escaped_bodies" = the escaped bodies' kinetic energy now and the
-// magnetic and contact work done on them since t = 0.
+// magnetic and contact work done on them since t = 0 (net, and "_in": the positive steps).
 // ΔK + ΔU_g = magnetic_work + contact_work − gravity_drift.
 json energy_json(const engine::Simulation& sim) {
   const engine::EnergyAudit& e = sim.energy();
   json j = energy_flow_json(e.total);
-  double k = 0.0, w_mag = 0.0, w_c = 0.0;
+  double k = 0.0, w_mag = 0.0, w_c = 0.0, w_mag_in = 0.0, w_c_in = 0.0;
   const std::vector<int> escaped = engine::escaped_bodies(sim.model(), sim.state());
   for (int b : escaped) {
     k += engine::kinetic_energy(sim.model(), sim.state(), b);
     w_mag += e.body_magnetic_work[b];
     w_c += e.body_contact_work[b];
+    w_mag_in += e.body_magnetic_work_in[b];
+    w_c_in += e.body_contact_work_in[b];
   }
-  j["escaped_bodies"] = {{"count", escaped.size()}, {"kinetic", k}, {"magnetic_work", w_mag}, {"contact_work", w_c}};
+  j["escaped_bodies"] = {{"count", escaped.size()}, {"kinetic", k},
+                         {"magnetic_work", w_mag}, {"contact_work", w_c},
+                         {"magnetic_work_in", w_mag_in}, {"contact_work_in", w_c_in}};
   j["kinetic"] = e.kinetic;
   j["gravitational"] = e.gravitational;
   j["initial_kinetic"] = e.initial_kinetic;

@@ -102,6 +102,7 @@ TEST_CASE("energy: an overlap pushed out by ERP is booked as contact work", "[en
   // one body: its own books are the totals, and all of the contact work went in
   CHECK(e.body_contact_work[0] == Approx(e.total.contact_work).epsilon(1e-12));
   CHECK(e.total.contact_work_in == Approx(e.total.contact_work).epsilon(1e-12));
+  CHECK(e.body_contact_work_in[0] >= e.body_contact_work[0]);
 }
 
 TEST_CASE("energy: the magnetic work on a ball pulled toward a magnet is its ΔK", "[energy]") {
@@ -121,6 +122,7 @@ TEST_CASE("energy: the magnetic work on a ball pulled toward a magnet is its ΔK
   CHECK(e.last.magnetic_work > 0.0);  // still accelerating toward the magnet
   CHECK(e.body_magnetic_work[1] == Approx(e.total.magnetic_work).epsilon(1e-12));
   CHECK(e.body_magnetic_work[0] == 0.0);  // the static magnet
+  CHECK(e.body_magnetic_work_in[1] == Approx(e.total.magnetic_work).epsilon(1e-12));  // always pulled
 }
 
 TEST_CASE("energy: magnetic torques are counted (an off-centre dumbbell turns)", "[energy]") {
