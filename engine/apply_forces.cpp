@@ -23,11 +23,21 @@ void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspac
 
 void apply_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws,
                            OdeBridge* ode) {
-  // net magnetic force per body
+  // net magnetic force per body, and the torque about its COM x_b that ODE will make of the
+  // forces at the moments' positions and the permanent moments' torques:
+  //   F_b = Σ_j F_j,  τ_b = Σ_j (p_j − x_b) × F_j + τ_j (τ_j of permanent moments only)
+  // (the energy audit's W_mag needs both; ODE gets the same loads below, unchanged)
   std::fill(ws->body_force.begin(), ws->body_force.end(), Vec3::Zero());
-  for (int j = 0; j < m.nmoment; ++j) {
-    const int b = m.moment_body[j];
-    if (m.body_type[b] == BodyType::Dynamic) ws->body_force[b] += ws->F[j];
+  std::fill(ws->body_torque.begin(), ws->body_torque.end(), Vec3::Zero());
+  for (int b : m.dynamic_bodies) {
+    const int adr = m.body_moment_adr[b], num = m.body_moment_num[b];
+    if (num == 0) continue;
+    const Vec3 x = ode->position(b);
+    for (int j = adr; j < adr + num; ++j) {
+      ws->body_force[b] += ws->F[j];
+      ws->body_torque[b] += (set.position[j] - x).cross(ws->F[j]);
+      if (m.moment_permanent[j]) ws->body_torque[b] += ws->tau[j];
+    }
   }
 
   // auto-disable: ODE sleeps on small velocities only, so wake a sleeping body whose

@@ -1,4 +1,5 @@
-// engine/metrics.cpp — energy, speed, extent, attachment and momentum of a state.
+// engine/metrics.cpp — energy, speed, extent, attachment (attached, held, escaped) and
+// momentum of a state.
 #include "engine/metrics.hpp"
 
 #include <algorithm>
@@ -36,7 +37,75 @@ int count_attached(const Model& m, const State& s) {
   return attached;
 }
 
+// Dynamic non-magnet bodies reachable from any magnet body through contact pairs without
+// passing through a body that touches the ground (a contact pair with −1): such a body is
+// supported by the floor, not held by the magnet, so it is neither counted nor walked
+// through. Magnet bodies are the seeds, whether or not they touch the ground themselves.
+int count_held(const Model& m, const State& s) {
+  if (s.contact_pairs.empty()) return 0;
+  std::vector<std::vector<int>> adj(m.nbody);
+  std::vector<std::uint8_t> grounded(m.nbody, 0);
+  for (const auto& [a, b] : s.contact_pairs) {
+    if (a < 0 || b < 0) {
+      grounded[a < 0 ? b : a] = 1;
+      continue;
+    }
+    adj[a].push_back(b);
+    adj[b].push_back(a);
+  }
+  std::vector<std::uint8_t> seen(m.nbody, 0);
+  std::vector<int> queue;
+  for (int b = 0; b < m.nbody; ++b)
+    if (m.body_magnet[b]) {
+      seen[b] = 1;
+      queue.push_back(b);
+    }
+  int held = 0;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    for (int nb : adj[queue[head]]) {
+      if (seen[nb] || grounded[nb] || m.body_type[nb] != BodyType::Dynamic) continue;
+      seen[nb] = 1;
+      ++held;
+      queue.push_back(nb);
+    }
+  }
+  return held;
+}
+
+// Dynamic non-magnet bodies farther than R_esc from c, the centroid of the magnet bodies:
+// |x − c| over (x, y) only when there is gravity (a ball that fell spreads out on the
+// floor; height says nothing about escape), over (x, y, z) in zero gravity.
+std::vector<int> find_escaped(const Model& m, const State& s) {
+  std::vector<int> escaped;
+  if (!(m.escape_radius > 0)) return escaped;
+  Vec3 c = Vec3::Zero();
+  int magnets = 0;
+  for (int b = 0; b < m.nbody; ++b)
+    if (m.body_magnet[b]) {
+      c += s.pos[b];
+      ++magnets;
+    }
+  if (magnets == 0) return escaped;
+  c /= static_cast<double>(magnets);
+  const bool horizontal = m.options.gravity.norm() != 0.0;
+  for (int b : m.dynamic_bodies) {
+    if (m.body_magnet[b]) continue;
+    Vec3 d = s.pos[b] - c;
+    if (horizontal) d.z() = 0.0;
+    if (d.norm() > m.escape_radius) escaped.push_back(b);
+  }
+  return escaped;
+}
+
 }  // namespace
+
+std::vector<int> escaped_bodies(const Model& m, const State& s) { return find_escaped(m, s); }
+
+double kinetic_energy(const Model& m, const State& s, int b) {
+  // E = ½ m |v|² + ½ ωᵀ (R I Rᵀ) ω
+  const Vec3 w_body = s.quat[b].toRotationMatrix().transpose() * s.angvel[b];
+  return 0.5 * m.body_mass[b] * s.vel[b].squaredNorm() + 0.5 * w_body.dot(m.body_inertia[b] * w_body);
+}
 
 Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last) {
   Metrics r;
@@ -51,11 +120,7 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
   for (int b : m.dynamic_bodies) {
     const double mass = m.body_mass[b];
     const Vec3& v = s.vel[b];
-    const Vec3& w = s.angvel[b];
-    const Mat3 R = s.quat[b].toRotationMatrix();
-    // E = ½ m |v|² + ½ ωᵀ (R I Rᵀ) ω
-    const Vec3 w_body = R.transpose() * w;
-    r.kinetic_energy += 0.5 * mass * v.squaredNorm() + 0.5 * w_body.dot(m.body_inertia[b] * w_body);
+    r.kinetic_energy += kinetic_energy(m, s, b);
     r.max_speed = std::max(r.max_speed, v.norm());
     r.momentum += mass * v;
     centroid += s.pos[b];
@@ -71,6 +136,8 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
       if (!m.body_magnet[b]) r.magnet_radius = std::max(r.magnet_radius, (s.pos[b] - s.pos[mb]).norm());
   }
   r.attached = count_attached(m, s);
+  r.held = count_held(m, s);
+  r.escaped = static_cast<int>(find_escaped(m, s).size());
   return r;
 }
 

@@ -19,6 +19,17 @@ struct Metrics {
   /// dynamic bodies (magnets excluded) reachable from a magnet body through the contact
   /// graph of the last step, walking through dynamic bodies only
   int attached = 0;
+  /// dynamic bodies (magnets excluded) reached from a magnet body through the contact graph
+  /// of the last step without passing through a body that touches the ground: a body with
+  /// a contact to the ground is neither counted nor walked through. Unlike `attached`, a
+  /// ball lying on the floor against a chain of balls is not held.
+  int held = 0;
+  /// dynamic bodies (magnets excluded) whose centre is farther than Model::escape_radius
+  /// from the centroid of the magnet bodies (the magnet itself when there is one): the
+  /// horizontal (x, y) distance when the scene has gravity (balls that fell off spread over
+  /// the floor; sakura_tree's 8 tip magnets centre on the trunk), the 3-D distance when
+  /// gravity is zero (alphabets). 0 when escape_radius is 0 or there is no magnet body.
+  int escaped = 0;
   Vec3 momentum = Vec3::Zero();  ///< Σ m v over dynamic bodies (kg·m/s), for drift
   int iterations = 0;            ///< magnetization iterations of the last step
   bool converged = true;         ///< the last step's magnetization converged
@@ -26,5 +37,12 @@ struct Metrics {
 };
 
 Metrics compute_metrics(const Model& model, const State& s, const StepProfile& last);
+
+/// The bodies Metrics::escaped counts, ascending (empty when escape_radius is 0).
+std::vector<int> escaped_bodies(const Model& model, const State& s);
+
+/// Kinetic energy of one body, ½ m |v|² + ½ ωᵀ I_world ω (J); the one formula of the
+/// metrics and the energy audit.
+double kinetic_energy(const Model& model, const State& s, int body);
 
 }  // namespace magsim::engine

@@ -225,6 +225,9 @@ Model compile_model(const SceneDesc& scene) {
   m.name = scene.name;
   m.description = scene.description;
   m.modelling_level = scene.modelling_level;
+  if (!(scene.escape_radius >= 0 && std::isfinite(scene.escape_radius)))
+    fail("escape_radius", "must be >= 0 and finite (got " + fmt(scene.escape_radius) + ")");
+  m.escape_radius = scene.escape_radius;
   m.nbody = static_cast<int>(scene.bodies.size());
 
   for (int i = 0; i < m.nbody; ++i) {

@@ -34,6 +34,7 @@ struct Model {
   Vec3 H0 = Vec3::Zero();  ///< uniform external field (A/m)
   render::Camera camera;
   std::string name, description, modelling_level;
+  double escape_radius = 0.0;  ///< SceneDesc::escape_radius (m), ≥ 0; 0 = not measured
 
   // bodies
   std::vector<std::string> body_name;         ///< (nbody)

@@ -408,6 +408,12 @@ bool OdeBridge::enabled(int i) const {
   return impl_->body[i] ? dBodyIsEnabled(impl_->body[i]) != 0 : false;
 }
 
+Vec3 OdeBridge::position(int i) const {
+  if (!impl_->body[i]) return Vec3::Zero();
+  const dReal* p = dBodyGetPosition(impl_->body[i]);
+  return Vec3(p[0], p[1], p[2]);
+}
+
 void OdeBridge::set_velocity(int i, const Vec3& v) {
   if (impl_->body[i]) dBodySetLinearVel(impl_->body[i], v.x(), v.y(), v.z());
 }

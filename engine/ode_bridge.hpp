@@ -45,6 +45,8 @@ class OdeBridge {
   /// Wakes a body put to sleep by auto-disable.
   void enable(int body);
   bool enabled(int body) const;
+  /// The ODE body's position (its centre of mass, m): what write_state() set until the step.
+  Vec3 position(int body) const;
   /// Overwrites a body's linear velocity (the test hook of the safety check).
   void set_velocity(int body, const Vec3& v);
 

@@ -187,6 +187,10 @@ struct SceneDesc {
   SimOptions options;
   render::Camera camera;        ///< framed on the action
   double default_seconds = 2.0; ///< simulated time of a default run
+  /// (m) "escaped" (Metrics::escaped) = a dynamic non-magnet body whose centre is farther
+  /// than this from the centroid of the magnet bodies: horizontal (x, y) distance when the
+  /// scene has gravity, 3-D distance without; 0 = not measured
+  double escape_radius = 0.0;
 };
 
 }  // namespace magsim::engine

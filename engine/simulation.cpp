@@ -38,9 +38,11 @@ Simulation::Simulation(const SceneDesc& scene)
   ws_.F.assign(m.nmoment, Vec3::Zero());
   ws_.tau.assign(m.nmoment, Vec3::Zero());
   ws_.body_force.assign(m.nbody, Vec3::Zero());
+  ws_.body_torque.assign(m.nbody, Vec3::Zero());
   ws_.body_force_awake.assign(m.nbody, Vec3::Zero());
   ws_.next = state_;
   ode_ = std::make_unique<OdeBridge>(m);
+  energy_ = start_energy_audit(m, state_);
   // SimOptions::threads > 0: exactly that many; 0: all, except for small systems (one)
   omp_threads_ = m.options.threads > 0 ? m.options.threads
                  : m.nmoment < kParallelMoments ? 1
@@ -73,6 +75,7 @@ void Simulation::restore_state(const State& s) {
   std::fill(ws_.body_force_awake.begin(), ws_.body_force_awake.end(), Vec3::Zero());
   rollback();
   profile_ = StepProfile{};
+  energy_ = start_energy_audit(*model_, state_);
 }
 
 void Simulation::rollback() {

@@ -12,6 +12,7 @@
 // (except with auto_disable, whose sleep counters ODE does not expose).
 #pragma once
 
+#include "engine/energy.hpp"
 #include "engine/frame_builder.hpp"
 #include "engine/metrics.hpp"
 #include "engine/profile.hpp"
@@ -47,6 +48,10 @@ class Simulation {
   long steps() const;
   const StepProfile& last_profile() const { return profile_; }
   Metrics metrics() const;
+  /// The energy audit since t = 0 (energy.hpp): K, U_g, the magnetic interaction energy,
+  /// the cumulative work of the magnetic forces, gravity and the contacts, and the same for
+  /// the last step. restore_state() starts it afresh from the restored state.
+  const EnergyAudit& energy() const { return energy_; }
   std::uint64_t state_hash() const;
 
   State save_state() const { return state_; }
@@ -84,6 +89,7 @@ class Simulation {
   Workspace ws_;
   std::unique_ptr<OdeBridge> ode_;
   StepProfile profile_;
+  EnergyAudit energy_;      ///< committed with state_ at the end of each step
   int omp_threads_ = 1;     ///< OpenMP threads the magnetics run with (see step.cpp)
   int inject_body_ = -1;
   Vec3 inject_velocity_ = Vec3::Zero();

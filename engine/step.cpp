@@ -7,6 +7,7 @@
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
 //   then read back, check for non-finite values, commit       safety.cpp
+//   (and the energy audit of the step, committed with it)     energy.cpp
 //
 // The step works on ws_.next and swaps it into state_ only when every check passes, so
 // state_ is always the last good state; on failure ODE and the moments are rewound to it.
@@ -27,6 +28,9 @@ void Simulation::step() {
   ScopedTimer total(&prof.total_ms);
   const long n = state_.step + 1;  // the step being taken, as named in errors
   omp_set_num_threads(omp_threads_);  // per calling thread; several Simulations may differ
+
+  // energy audit (energy.hpp) of this step, committed with the state
+  begin_audit_step(energy_, &ws_.audit);
 
   try {
     // (1) ODE takes the state; moments take world positions (and permanent moments their
@@ -50,6 +54,10 @@ void Simulation::step() {
         ScopedTimer t(&prof.sync_ms);
         ode_->read_state(&ws_.next);
         place_moments(m, ws_.next, &moments_);
+        // energy audit of the sub-step just taken (its forces are still in ws_)
+        audit_substep(m, k == 1 ? state_ : ws_.sub_prev, ws_.next, ws_.body_force,
+                      ws_.body_torque, h, &ws_.audit);
+        ws_.sub_prev = ws_.next;
       }
       const State& now = k == 0 ? state_ : ws_.next;
 
@@ -100,6 +108,11 @@ void Simulation::step() {
       check_bodies(m, next, n);
       next.dvel.resize(m.nbody);
       for (int b = 0; b < m.nbody; ++b) next.dvel[b] = next.vel[b] - state_.vel[b];
+      // energy audit: the work of the last ODE step (O(bodies)); U_mag from the forces' field
+      audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque, h,
+                    &ws_.audit);
+      ws_.audit.magnetic_energy = magnetic_energy(moments_, ws_.mag.H);
+      std::swap(energy_, ws_.audit);
       std::swap(state_, next);
       place_moments(m, state_, &moments_);  // moments() follows the new poses
     }

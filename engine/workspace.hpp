@@ -2,6 +2,7 @@
 // Sized once; a warm step allocates nothing.
 #pragma once
 
+#include "engine/energy.hpp"
 #include "engine/state.hpp"
 #include "magnetics/magnetization.hpp"
 
@@ -14,9 +15,14 @@ struct Workspace {
   std::vector<mag::Vec3> F;       ///< (nmoment) magnetic force on each moment (N)
   std::vector<mag::Vec3> tau;     ///< (nmoment) magnetic torque on each moment (N·m)
   std::vector<Vec3> body_force;   ///< (nbody) net magnetic force on each body this step (N)
+  /// (nbody) net magnetic torque on each body about its COM this step (N·m): the lever arms
+  /// of its moments' forces and the torques of its permanent moments (energy audit)
+  std::vector<Vec3> body_torque;
   /// (nbody) net magnetic force when the body was last awake (auto-disable wake-up)
   std::vector<Vec3> body_force_awake;
+  State sub_prev;                 ///< the state after the last sub-step (energy audit)
   State next;                     ///< the state being computed; swapped in when it checks out
+  EnergyAudit audit;              ///< the energy audit being computed, committed with next
 };
 
 }  // namespace magsim::engine

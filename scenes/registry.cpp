@@ -92,6 +92,8 @@ SceneDesc balls_up(const SceneParams& p) {
   s.camera.eye = Eigen::Vector3f(0.16f, -0.20f, 0.12f);
   s.camera.target = Eigen::Vector3f(0.0f, 0.0f, 0.03f);
   s.default_seconds = 3.0;
+  // the pile spans ±4 cm; a ball farther than 15 cm sideways from the magnet was thrown
+  s.escape_radius = 0.15;  // (m)
   return s;
 }
 
@@ -184,6 +186,9 @@ SceneDesc alphabets(const SceneParams& p) {
   s.camera.eye = Eigen::Vector3f(0.45f, -0.55f, 0.30f);
   s.camera.target = Eigen::Vector3f(0, 0, 0);
   s.default_seconds = 3.0;
+  // the grid's corners start 0.22 m from the centre (3-D, no gravity): beyond 0.3 m a
+  // letter is flying away, not gathering
+  s.escape_radius = 0.3;  // (m)
   return s;
 }
 
@@ -227,6 +232,8 @@ SceneDesc falling_magnet(const SceneParams& p) {
   s.camera.eye = Eigen::Vector3f(0.26f, -0.32f, 0.22f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.03f);
   s.default_seconds = 2.0;
+  // the pile spans ±5.5 cm; a ball 1 m sideways from the magnet was thrown off the table
+  s.escape_radius = 1.0;  // (m)
   return s;
 }
 
@@ -305,6 +312,9 @@ SceneDesc sakura_tree(const SceneParams& p) {
   s.camera.eye = Eigen::Vector3f(0.55f, -0.65f, 0.45f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.17f);
   s.default_seconds = 2.0;
+  // the sheet spans ±0.27 m over the trunk (the 8 tip magnets centre on it horizontally);
+  // acceptance (#12): no ball beyond 0.5 m of the trunk
+  s.escape_radius = 0.5;  // (m)
   return s;
 }
 
@@ -350,6 +360,7 @@ SceneDesc crystal_balls(const SceneParams& p) {
   s.camera.eye = Eigen::Vector3f(0.12f, -0.16f, 0.16f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.1f);
   s.default_seconds = 0.05;
+  s.escape_radius = 0.0;  // static balls: escape is not measured
   return s;
 }
 

@@ -8,6 +8,7 @@
 //     "name": "two_balls",                      // default: the file name without .json
 //     "description": "…", "modelling_level": "…",
 //     "default_seconds": 2.0,                   // > 0 (s)
+//     "escape_radius": 0,                       // >= 0 (m); 0 = "escaped" not measured
 //     "H0": [0, 0, 0],                          // uniform external field (A/m)
 //     "camera": {"eye": [x,y,z], "target": [x,y,z], "up": [x,y,z],
 //                "fov_y_deg": 40, "z_near": 0, "z_far": 0},
@@ -461,8 +462,8 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
     r.fail("", "malformed JSON: " + what);
   }
 
-  r.keys(doc, "", {"name", "description", "modelling_level", "default_seconds", "H0", "camera",
-                   "options", "bodies"});
+  r.keys(doc, "", {"name", "description", "modelling_level", "default_seconds", "escape_radius",
+                   "H0", "camera", "options", "bodies"});
   SceneDesc s;
   s.name = stem(origin);
   opt(doc, "name", "", [&](const json& v, const std::string& p) { s.name = r.string(v, p); });
@@ -471,6 +472,7 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   opt(doc, "description", "", [&](const json& v, const std::string& p) { s.description = r.string(v, p); });
   opt(doc, "modelling_level", "", [&](const json& v, const std::string& p) { s.modelling_level = r.string(v, p); });
   opt(doc, "default_seconds", "", [&](const json& v, const std::string& p) { s.default_seconds = r.positive(v, p); });
+  opt(doc, "escape_radius", "", [&](const json& v, const std::string& p) { s.escape_radius = r.non_negative(v, p); });
   opt(doc, "H0", "", [&](const json& v, const std::string& p) { s.H0 = r.vec3(v, p); });
   opt(doc, "camera", "", [&](const json& v, const std::string& p) { read_camera(r, v, p, &s.camera); });
   opt(doc, "options", "", [&](const json& v, const std::string& p) { read_options(r, v, p, &s.options); });

@@ -3,6 +3,8 @@
 write (Debian's python3-matplotlib; no other dependency).
 
     /usr/bin/python3 tools/charts.py OUT_DIR    reads OUT_DIR/*.csv|json, writes OUT_DIR/*.png
+    /usr/bin/python3 tools/charts.py energy SUMMARY.json OUT.png
+                                                the energy audit of one magsim-scene run
 
 Every chart is skipped (with a note) when its data file is missing, so a partial run still
 draws what it has."""
@@ -340,7 +342,72 @@ def bench(out):
         plt.close(fig)
 
 
+ENERGY_SERIES = (("energy_kinetic", "kinetic K", "tab:blue"),
+                 ("energy_gravitational", "gravitational U_g − U_g(0)", "tab:brown"),
+                 ("energy_magnetic_work", "magnetic work W_mag", "tab:red"),
+                 ("energy_contact_work", "contact work W_c", "tab:green"),
+                 ("energy_magnetic", "magnetic energy U_mag − U_mag(first)", "tab:purple"))
+
+
+def energy(summary_path, png_path):
+    """The energy audit of one run (magsim-scene's summary.json, engine/energy.hpp): K, U_g,
+    the cumulative magnetic and contact work and U_mag over time (offsets removed so that
+    every curve starts at 0 except K), and below, the power of the magnetic forces and of
+    the contacts between frames (J/s): where the energy of scattered bodies comes from."""
+    with open(summary_path) as f:
+        s = json.load(f)
+    ser = s.get("series", {})
+    if "energy_kinetic" not in ser:
+        print(f"charts: {summary_path} has no energy series (older magsim-scene?)", file=sys.stderr)
+        sys.exit(1)
+    t = ser["time"]
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 2]})
+    for key, label, color in ENERGY_SERIES:
+        tt, y = t, ser[key]
+        if key == "energy_magnetic":
+            # U_mag is known from the first step on (the frame at t = 0 holds 0)
+            tt, y = t[1:], y[1:]
+        if key in ("energy_gravitational", "energy_magnetic") and y:
+            y = [v - y[0] for v in y]
+        ax.plot(tt, y, label=label, color=color)
+    ax.axhline(0, color="black", linewidth=0.5)
+    ax.set_ylabel("J")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    e = s.get("energy", {})
+    ax.set_title(f"{s.get('scene')} {s.get('method')}: energy audit "
+                 f"(final W_mag {e.get('magnetic_work', float('nan')):.3g} J, "
+                 f"W_c {e.get('contact_work', float('nan')):.3g} J, K {e.get('kinetic', float('nan')):.3g} J)",
+                 fontsize=10)
+    for key, label, color in (("energy_magnetic_work", "magnetic", "tab:red"),
+                              ("energy_contact_work", "contacts", "tab:green")):
+        y = ser[key]
+        p = [(y[i] - y[i - 1]) / (t[i] - t[i - 1]) for i in range(1, len(t)) if t[i] > t[i - 1]]
+        tm = [0.5 * (t[i] + t[i - 1]) for i in range(1, len(t)) if t[i] > t[i - 1]]
+        ax2.plot(tm, p, label=f"power of the {label}", color=color)
+    ax2.axhline(0, color="black", linewidth=0.5)
+    ax2.set_yscale("symlog", linthresh=1e-3)
+    ax2.set_xlabel("simulated time (s)")
+    ax2.set_ylabel("W (J/s), between frames")
+    ax2.grid(True, alpha=0.3)
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png_path, dpi=110)
+    plt.close(fig)
+    print(f"charts: written {png_path}")
+
+
 def main():
+    if len(sys.argv) >= 2 and sys.argv[1] == "energy":
+        if len(sys.argv) != 4:
+            print("usage: charts.py energy SUMMARY.json OUT.png", file=sys.stderr)
+            sys.exit(2)
+        if not os.path.isfile(sys.argv[2]):
+            print(f"charts: {sys.argv[2]} is not a file", file=sys.stderr)
+            sys.exit(2)
+        energy(sys.argv[2], sys.argv[3])
+        return
     if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
         print(__doc__)
         sys.exit(0 if len(sys.argv) == 2 else 2)

@@ -1,7 +1,8 @@
 // tools/magsim_scene.cpp — runs one scene (from the registry or a JSON file) with one
 // method and writes what happened: summary.json (options, timings T_i/T_f/T_r, iteration
-// statistics, final metrics, per-frame series, state hash, error), states.csv (body poses
-// per frame) and moments.csv (magnetizations per frame).
+// statistics, final metrics — attached, held, escaped beyond escape_radius, … —, the
+// energy audit, per-frame series, state hash, error), states.csv (body poses per frame) and
+// moments.csv (magnetizations per frame).
 //
 //   magsim-scene balls_up --method kim2018 --seconds 2
 //   magsim-scene scenes/examples/two_balls.json --steps 500 --out out/two
@@ -306,11 +307,25 @@ class Recorder {
     series_["bounding_radius"].push_back(x.bounding_radius);
     series_["magnet_radius"].push_back(x.magnet_radius);
     series_["attached"].push_back(x.attached);
+    series_["held"].push_back(x.held);
+    series_["escaped"].push_back(x.escaped);
     series_["iterations"].push_back(x.iterations);
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
     series_["substeps"].push_back(sim_.last_profile().substeps);
     check();
+    // the energy audit (engine/energy.hpp): state functions and cumulative work (J), and the
+    // last step's magnetic and contact work (J per step)
+    const engine::EnergyAudit& e = sim_.energy();
+    series_["energy_kinetic"].push_back(e.kinetic);
+    series_["energy_gravitational"].push_back(e.gravitational);
+    series_["energy_magnetic"].push_back(e.magnetic_energy);
+    series_["energy_magnetic_work"].push_back(e.total.magnetic_work);
+    series_["energy_contact_work"].push_back(e.total.contact_work);
+    series_["energy_gravity_work"].push_back(e.total.gravity_work);
+    series_["energy_gravity_drift"].push_back(e.total.gravity_drift);
+    series_["energy_step_magnetic_work"].push_back(e.last.magnetic_work);
+    series_["energy_step_contact_work"].push_back(e.last.contact_work);
     return true;
   }
   int frames() const { return frames_; }
@@ -331,6 +346,45 @@ class Recorder {
   int frames_ = 0;
   json series_ = json::object();
 };
+
+json energy_flow_json(const engine::EnergyFlow& f) {
+  return json{{"kinetic_change", f.kinetic_change},
+              {"gravitational_change", f.gravitational_change},
+              {"magnetic_work", f.magnetic_work},
+              {"gravity_work", f.gravity_work},
+              {"contact_work", f.contact_work},
+              {"gravity_drift", f.gravity_drift},
+              {"contact_work_in", f.contact_work_in}};
+}
+
+// summary.json "energy": the audit at the end of the run (J); "last_step" = the increments
+// of the final step; "escaped_bodies" = the escaped bodies' kinetic energy now and the
+// magnetic and contact work done on them since t = 0 (net, and "_in": the positive steps).
+// ΔK + ΔU_g = magnetic_work + contact_work − gravity_drift.
+json energy_json(const engine::Simulation& sim) {
+  const engine::EnergyAudit& e = sim.energy();
+  json j = energy_flow_json(e.total);
+  double k = 0.0, w_mag = 0.0, w_c = 0.0, w_mag_in = 0.0, w_c_in = 0.0;
+  const std::vector<int> escaped = engine::escaped_bodies(sim.model(), sim.state());
+  for (int b : escaped) {
+    k += engine::kinetic_energy(sim.model(), sim.state(), b);
+    w_mag += e.body_magnetic_work[b];
+    w_c += e.body_contact_work[b];
+    w_mag_in += e.body_magnetic_work_in[b];
+    w_c_in += e.body_contact_work_in[b];
+  }
+  j["escaped_bodies"] = {{"count", escaped.size()}, {"kinetic", k},
+                         {"magnetic_work", w_mag}, {"contact_work", w_c},
+                         {"magnetic_work_in", w_mag_in}, {"contact_work_in", w_c_in}};
+  j["kinetic"] = e.kinetic;
+  j["gravitational"] = e.gravitational;
+  j["initial_kinetic"] = e.initial_kinetic;
+  j["initial_gravitational"] = e.initial_gravitational;
+  j["magnetic_energy"] = e.magnetic_energy;
+  j["substeps"] = e.substeps;
+  j["last_step"] = energy_flow_json(e.last);
+  return j;
+}
 
 json options_json(const engine::Model& m) {
   const engine::SimOptions& o = m.options;
@@ -551,6 +605,7 @@ int run(const Args& a, const CLI::App& app) {
       {"method", method},
       {"options", options_json(model)},
       {"params", {{"count", a.count}, {"strength", app.count("--strength") ? a.strength : 1.0}}},
+      {"escape_radius", model.escape_radius},
       {"bodies", model.nbody},
       {"dynamic_bodies", model.dynamic_bodies.size()},
       {"moments", model.nmoment},
@@ -587,8 +642,11 @@ int run(const Args& a, const CLI::App& app) {
         {"bounding_radius", fin.bounding_radius},
         {"magnet_radius", fin.magnet_radius},
         {"attached", fin.attached},
+        {"held", fin.held},
+        {"escaped", fin.escaped},
         {"momentum", vec3(fin.momentum)},
         {"contacts", fin.contacts}}},
+      {"energy", energy_json(sim)},
       {"series", rec.series()},
       {"state_hash", hash},
       {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};

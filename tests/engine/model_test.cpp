@@ -68,6 +68,14 @@ TEST_CASE("model: other invalid inputs are rejected with the field named", "[mod
     s.bodies[0].mass = -1;
     CHECK_THAT(compile_error(s), Contains("body 0 'ball_0'") && Contains("mass"));
   }
+  SECTION("negative or non-finite escape radius") {
+    s.escape_radius = -0.1;
+    CHECK_THAT(compile_error(s), Contains("escape_radius: must be >= 0 and finite (got -0.1)"));
+    s.escape_radius = std::numeric_limits<double>::infinity();
+    CHECK_THAT(compile_error(s), Contains("escape_radius"));
+    s.escape_radius = 0.2;
+    CHECK(compile_error(s).empty());
+  }
   SECTION("dt outside (0, 0.1]") {
     s.options.dt = 0.5;
     CHECK_THAT(compile_error(s), Contains("options.dt"));

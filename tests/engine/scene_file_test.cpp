@@ -62,6 +62,7 @@ TEST_CASE("scene_file: the example loads and its balls rise to the magnet", "[sc
 TEST_CASE("scene_file: a minimal file takes the SceneDesc defaults", "[scene_file]") {
   const engine::SceneDesc s = scenes::parse_scene_json(kGood, "dir/minimal.json");
   CHECK(s.name == "minimal");
+  CHECK(s.escape_radius == 0.0);  // not measured unless the file says
   CHECK(s.options.dt == 1e-3);
   CHECK(s.bodies[1].moments[0].Ms == 1.6e6);
   CHECK(s.bodies[1].type == engine::BodyType::Dynamic);
@@ -79,7 +80,7 @@ TEST_CASE("scene_file: every options key is read", "[scene_file]") {
                               "adaptive_gamma_bound": false, "adaptive_gamma_cap": 2,
                               "tol": 1e-5, "max_iter": 50, "min_pair_angle": 1e-5,
                               "theta_integrator": "euler", "softening": 1e-3}},
-    "H0": [1, 2, 3], "default_seconds": 0.5,
+    "H0": [1, 2, 3], "default_seconds": 0.5, "escape_radius": 0.25,
     "camera": {"eye": [1, 1, 1], "target": [0, 0, 0.1], "up": [0, 0, 1], "fov_y_deg": 30},
     "bodies": []})", "x.json");
   const engine::SimOptions& o = s.options;
@@ -98,6 +99,7 @@ TEST_CASE("scene_file: every options key is read", "[scene_file]") {
   CHECK(!o.magnetics.adaptive_gamma_bound);
   CHECK(s.H0 == engine::Vec3(1, 2, 3));
   CHECK(s.default_seconds == 0.5);
+  CHECK(s.escape_radius == 0.25);
   CHECK(s.camera.fov_y_deg == 30.0f);
 }
 
@@ -128,6 +130,10 @@ TEST_CASE("scene_file: bad files fail with the file and the JSON path", "[scene_
   CHECK_THAT(error_of(R"({"bodies": [{"shapes": []}]})"), Contains("bodies[0].shapes: a dynamic body needs"));
   CHECK_THAT(error_of(R"({"name": "x"})"), Contains("scene.json: bodies: required"));
   CHECK_THAT(error_of(R"({"bodies": [], "extra": 1})"), Contains("scene.json: extra: unknown key"));
+  CHECK_THAT(error_of(R"({"bodies": [], "escape_radius": -0.5})"),
+             Contains("scene.json: escape_radius: must be >= 0 (got -0.5)"));
+  CHECK_THAT(error_of(R"({"bodies": [], "escape_radius": "far"})"),
+             Contains("scene.json: escape_radius: must be a number"));
   CHECK_THAT(error_of(R"({"bodies": [], "H0": [0, 0, 1e999]})"), Contains("scene.json: malformed JSON"));
   try {
     scenes::load_scene_file("/nonexistent/scene.json");

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -35,6 +36,26 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
   CHECK(j["options"]["quickstep_iterations"] == 7);
   CHECK(j["options"]["auto_disable"] == true);
   CHECK(j["steps"] == 3);
+  // attachment metrics next to "attached", final and per frame
+  CHECK(j["escape_radius"] == 0.15);
+  CHECK(j["final"]["held"].is_number_integer());
+  CHECK(j["final"]["escaped"] == 0);  // 3 ms: nothing has left the pile
+  CHECK(j["series"]["held"].size() == j["series"]["attached"].size());
+  CHECK(j["series"]["escaped"].size() == j["series"]["time"].size());
+  // the energy audit: final values and per-frame series; its books balance
+  const auto& e = j["energy"];
+  CHECK(e["substeps"] == 3);
+  const double balance = e["kinetic_change"].get<double>() + e["gravitational_change"].get<double>() -
+                         e["magnetic_work"].get<double>() - e["contact_work"].get<double>() +
+                         e["gravity_drift"].get<double>();
+  CHECK(std::abs(balance) <= 1e-12 + 1e-9 * std::abs(e["magnetic_work"].get<double>()));
+  CHECK(e["kinetic"].get<double>() == Approx(j["final"]["kinetic_energy"].get<double>()).epsilon(1e-12));
+  CHECK(e["magnetic_energy"].get<double>() < 0);  // iron drawn to the magnet: bound
+  CHECK(e["escaped_bodies"]["count"] == j["final"]["escaped"]);
+  CHECK(e["contact_work_in"].get<double>() >= 0);
+  for (const char* k : {"energy_kinetic", "energy_gravitational", "energy_magnetic_work",
+                        "energy_contact_work", "energy_magnetic"})
+    CHECK(j["series"][k].size() == j["series"]["time"].size());
 }
 
 TEST_CASE("magsim-scene: the default broad phase is sweep and prune", "[tools]") {
