@@ -9,45 +9,18 @@ namespace magsim::engine {
 namespace {
 
 // Dynamic bodies reachable from any magnet body through contact pairs, walking through
-// dynamic bodies only (a ball on the floor is not attached because the floor touches it).
-int count_attached(const Model& m, const State& s) {
-  if (s.contact_pairs.empty()) return 0;
-  std::vector<std::vector<int>> adj(m.nbody);
-  for (const auto& [a, b] : s.contact_pairs) {
-    if (a < 0 || b < 0) continue;  // the ground
-    adj[a].push_back(b);
-    adj[b].push_back(a);
-  }
-  std::vector<std::uint8_t> seen(m.nbody, 0);
-  std::vector<int> queue;
-  for (int b = 0; b < m.nbody; ++b)
-    if (m.body_magnet[b]) {
-      seen[b] = 1;
-      queue.push_back(b);
-    }
-  int attached = 0;
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    for (int nb : adj[queue[head]]) {
-      if (seen[nb] || m.body_type[nb] != BodyType::Dynamic) continue;
-      seen[nb] = 1;
-      ++attached;
-      queue.push_back(nb);
-    }
-  }
-  return attached;
-}
-
-// Dynamic non-magnet bodies reachable from any magnet body through contact pairs without
-// passing through a body that touches the ground (a contact pair with −1): such a body is
+// dynamic bodies only. `attached` (skip_grounded = false): a ball on the floor is not attached
+// because the floor touches it, but one lying on the floor against a chain of balls is.
+// `held` (skip_grounded = true): a body that touches the ground (a contact pair with −1) is
 // supported by the floor, not held by the magnet, so it is neither counted nor walked
 // through. Magnet bodies are the seeds, whether or not they touch the ground themselves.
-int count_held(const Model& m, const State& s) {
+int count_reachable(const Model& m, const State& s, bool skip_grounded) {
   if (s.contact_pairs.empty()) return 0;
   std::vector<std::vector<int>> adj(m.nbody);
   std::vector<std::uint8_t> grounded(m.nbody, 0);
   for (const auto& [a, b] : s.contact_pairs) {
-    if (a < 0 || b < 0) {
-      grounded[a < 0 ? b : a] = 1;
+    if (a < 0 || b < 0) {  // the ground
+      grounded[a < 0 ? b : a] = skip_grounded ? 1 : 0;
       continue;
     }
     adj[a].push_back(b);
@@ -60,16 +33,16 @@ int count_held(const Model& m, const State& s) {
       seen[b] = 1;
       queue.push_back(b);
     }
-  int held = 0;
+  int count = 0;
   for (std::size_t head = 0; head < queue.size(); ++head) {
     for (int nb : adj[queue[head]]) {
       if (seen[nb] || grounded[nb] || m.body_type[nb] != BodyType::Dynamic) continue;
       seen[nb] = 1;
-      ++held;
+      ++count;
       queue.push_back(nb);
     }
   }
-  return held;
+  return count;
 }
 
 // Dynamic non-magnet bodies farther than R_esc from c, the centroid of the magnet bodies:
@@ -135,8 +108,8 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
     for (int b : m.dynamic_bodies)
       if (!m.body_magnet[b]) r.magnet_radius = std::max(r.magnet_radius, (s.pos[b] - s.pos[mb]).norm());
   }
-  r.attached = count_attached(m, s);
-  r.held = count_held(m, s);
+  r.attached = count_reachable(m, s, false);
+  r.held = count_reachable(m, s, true);
   r.escaped = static_cast<int>(find_escaped(m, s).size());
   return r;
 }

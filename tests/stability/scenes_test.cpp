@@ -29,6 +29,23 @@ TEST_CASE("balls_up: ours settles with every ball attached while Kim 2018 keeps 
   CHECK(kim.min_attached_tail < 200);
 }
 
+TEST_CASE("falling_magnet without magnetism comes to rest: rolling resistance on the ground",
+          "[stability][falling_magnet]") {
+  // The mechanical control of issue #12: the 12×12×8 block collapses under the falling
+  // magnet (strength 0.001: no magnetic force to speak of). Without rolling resistance the
+  // balls rolled on for ever (final KE 0.126 J, 0.69 m/s through the last second, 17 beyond
+  // 1 m at 2 s). With the scene's ρ = 0.2 r: final KE 7.8e-6 J, none beyond 1 m; the fastest
+  // instantaneous velocity of the last second is 0.21 m/s, single balls chattering in the
+  // pile's contacts (their displacement between 60 fps frames gives ≤ 0.062 m/s).
+  const auto r = run_scene("falling_magnet", Method::OursRealigned, 2.0, 1.0, 0, 0.001);
+  INFO("last second: fastest " << r.tail_max_speed << " m/s; KE " << r.last.kinetic_energy
+                               << " J; escaped " << r.last.escaped);
+  REQUIRE_FALSE(r.failed);
+  CHECK(r.last.kinetic_energy < 1e-4);  // J; 13× the measured 7.8e-6, 1/1000 of no resistance
+  CHECK(r.tail_max_speed < 0.5);        // m/s; rolling on without resistance: 0.69
+  CHECK(r.last.escaped == 0);           // none beyond 1 m (17 without resistance)
+}
+
 TEST_CASE("sakura_tree: balls land on the branch-end magnets and stay without being flung",
           "[stability][sakura_tree]") {
   // 500 balls (23 × 23 sheet over the tree), 0.6 s: they reach the tips at ≈ 0.16 s. Measured
