@@ -200,11 +200,11 @@ struct OdeBridge::Impl {
       surface.bounce = o.restitution;
       surface.bounce_vel = 1e-3;
     }
+    surface.soft_erp = o.erp;
+    surface.soft_cfm = o.cfm;
     // rolling resistance (contacts with the ground and static bodies, see collide): the two
     // rolling rows and the spinning row carry a torque of at most ρ·N (dContactRolling with
     // dContactApprox1: limits ∝ the normal force)
-    surface.soft_erp = o.erp;
-    surface.soft_cfm = o.cfm;
     rolling = surface;
     if (o.rolling_friction > 0) {
       rolling.mode |= dContactRolling | dContactApprox1;

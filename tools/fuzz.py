@@ -92,18 +92,25 @@ def finite_json(v):
     return True
 
 
+def run(cmd, timeout, which):
+    """(process, None) when cmd exited 0; (None, reason) on a hang or a signal; (None, None)
+    on a clean non-zero exit (a refusal, which is what bad input should get)."""
+    try:
+        p = subprocess.run(cmd, capture_output=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, "hang"
+    if p.returncode < 0:
+        return None, f"signal {-p.returncode}"
+    EXIT0[which] += p.returncode == 0
+    return (p, None) if p.returncode == 0 else (None, None)
+
+
 def check_scene(path, out, timeout):
     shutil.rmtree(out, ignore_errors=True)
-    try:
-        p = subprocess.run([SCENE, path, "--steps", "30", "--no-render", "--threads", "1",
-                            "--out", out], capture_output=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return "hang"
-    if p.returncode < 0:
-        return f"signal {-p.returncode}"
-    EXIT0[0] += p.returncode == 0
-    if p.returncode != 0:
-        return None
+    p, why = run([SCENE, path, "--steps", "30", "--no-render", "--threads", "1", "--out", out],
+                 timeout, 0)
+    if p is None:
+        return why
     try:
         s = json.load(open(os.path.join(out, "summary.json")))
     except Exception as e:
@@ -120,15 +127,9 @@ def check_scene(path, out, timeout):
 
 
 def check_solve(path, timeout):
-    try:
-        p = subprocess.run([SOLVE, path], capture_output=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return "hang"
-    if p.returncode < 0:
-        return f"signal {-p.returncode}"
-    EXIT0[1] += p.returncode == 0
-    if p.returncode != 0:
-        return None
+    p, why = run([SOLVE, path], timeout, 1)
+    if p is None:
+        return why
     try:
         v = json.loads(p.stdout)
     except Exception as e:
