@@ -15,6 +15,7 @@
 #include "render/frame_writer.hpp"
 #include "render/renderer.hpp"
 #endif
+#include "scenes/options_json.hpp"
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
 #include "tools/field_flags.hpp"
@@ -386,51 +387,6 @@ json energy_json(const engine::Simulation& sim) {
   return j;
 }
 
-json options_json(const engine::Model& m) {
-  const engine::SimOptions& o = m.options;
-  const mag::DynamicsOptions& d = o.magnetics;
-  return json{{"dt", o.dt},
-              {"dt_m", d.dt},
-              {"beta", d.beta},
-              {"alpha", d.alpha},
-              {"gamma_c_max", d.gamma_c_max},
-              {"adaptive_gamma_bound", d.adaptive_gamma_bound},
-              {"adaptive_gamma_cap", d.adaptive_gamma_cap},
-              {"tol", d.tol},
-              {"max_iter", d.max_iter},
-              {"min_pair_angle", d.min_pair_angle},
-              {"theta_integrator", d.theta_integrator == mag::ThetaIntegrator::Exact ? "exact" : "euler"},
-              {"softening", d.field.softening},
-              {"field_solver", mag::field_solver_name(d.field.solver)},
-              {"field_solver_used", mag::field_solver_name(mag::resolve_solver(d.field, static_cast<std::size_t>(m.nmoment)))},
-              {"bh_theta", d.field.bh_theta},
-              {"bh_threshold", d.field.auto_threshold},
-              {"threads", o.threads},
-              {"max_body_speed", o.max_body_speed},
-              {"gravity", vec3(o.gravity)},
-              {"ground", o.ground},
-              {"friction", o.friction},
-              {"restitution", o.restitution},
-              {"erp", o.erp},
-              {"cfm", o.cfm},
-              {"quickstep_iterations", o.quickstep_iterations},
-              {"max_contacts", o.max_contacts},
-              {"space", engine::space_name(o.space)},
-              {"auto_disable", o.auto_disable},
-              {"force_model", engine::force_choice_name(o.force_model)},
-              {"max_substeps", o.max_substeps},
-              {"substep_reach", o.substep_reach},
-              {"rolling_friction", o.rolling_friction},
-              {"quickstep_w", o.quickstep_w},
-              {"bounded_pairs", d.field.bounded_pairs},
-              {"linear_damping", o.linear_damping},
-              {"angular_damping", o.angular_damping},
-              {"surface_layer", o.surface_layer},
-              {"max_correcting_velocity", o.max_correcting_velocity},
-              {"contact_margin", m.contact_margin},
-              {"H0", vec3(m.H0)}};
-}
-
 // ---- rendering ----------------------------------------------------------------------
 // With the renderer built in (MAGSIM_HAVE_RENDER) and without --no-render, every recorded
 // frame is drawn: sim.frame(opts) → magsim::render::Renderer → DIR/frame_%06d.png, PNGs written by a
@@ -603,7 +559,13 @@ int run(const Args& a, const CLI::App& app) {
       {"description", scene.description},
       {"modelling_level", scene.modelling_level},
       {"method", method},
-      {"options", options_json(model)},
+      // the run's options in the scene file's spelling (scenes/options_json.hpp): pasted into
+      // a scene file as "options" they rerun this run
+      {"options", scenes::to_json(model.options)},
+      {"field_solver_used", mag::field_solver_name(mag::resolve_solver(model.options.magnetics.field,
+                                                                        static_cast<std::size_t>(model.nmoment)))},
+      {"contact_margin_used", model.contact_margin},
+      {"H0", vec3(model.H0)},
       {"params", {{"count", a.count}, {"strength", app.count("--strength") ? a.strength : 1.0}}},
       {"escape_radius", model.escape_radius},
       {"bodies", model.nbody},
@@ -717,8 +679,8 @@ int main(int argc, char** argv) {
                "moments.csv"};
   Args a;
   app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
-  app.add_option("--method", a.method, "ours-realigned | ours | kim2018 | damping-llg | anderson | exact (default: the scene's, ours-realigned)")
-      ->check(CLI::IsMember({"ours", "ours-realigned", "kim2018", "damping-llg", "anderson", "exact"}));
+  app.add_option("--method", a.method, scenes::method_list(" | ") + " (default: the scene's, ours-realigned)")
+      ->check(CLI::IsMember(scenes::method_names()));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(kFinitePositive);
   auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, static_cast<long>(kMaxSteps)));
