@@ -127,6 +127,7 @@ struct Args {
   std::string bounded_pairs;
   magsim::tools::FieldFlags field;
   bool list = false;
+  std::string write_scene;
 };
 
 bool ends_with(const std::string& s, const std::string& tail) {
@@ -648,6 +649,25 @@ int run(const Args& a, const CLI::App& app) {
   return kOk;
 }
 
+// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written to
+// FILE.tmp and renamed, so a failed write leaves no half file under the name.
+int write_scene(const Args& a, const CLI::App& app) {
+  const engine::SceneDesc scene = resolve_scene(a, app);
+  const fs::path path = a.write_scene;
+  const fs::path tmp = path.string() + ".tmp";
+  std::ofstream out(tmp);
+  out << scenes::scene_to_json(scene).dump(1) << '\n';
+  out.close();
+  std::error_code ec;
+  if (!out || (fs::rename(tmp, path, ec), ec)) {
+    const std::string why = ec ? ec.message() : errno_text();
+    fs::remove(tmp, ec);
+    throw IoError("--write-scene: cannot write " + path.string() + " (" + why + ")");
+  }
+  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), path.c_str());
+  return kOk;
+}
+
 // --seconds / --fps: CLI::PositiveNumber lets nan and inf through
 const auto kFinitePositive = CLI::Validator(
     [](std::string& v) -> std::string {
@@ -728,6 +748,9 @@ int main(int argc, char** argv) {
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
               "--bh-threshold moments on");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
+  app.add_option("--write-scene", a.write_scene,
+                 "write the scene (with --count, --strength and the option flags applied) as a scene "
+                 "FILE.json to edit and run, and exit without running");
 
   app.footer("Exit codes: 0 done, 1 bad usage, flags or scene, 2 the simulation failed (summary.json "
              "holds the error), 3 an output file could not be written.\nRuns longer than 1e7 rigid "
@@ -753,6 +776,7 @@ int main(int argc, char** argv) {
     return kBadInput;
   }
   try {
+    if (!a.write_scene.empty()) return write_scene(a, app);
     return run(a, app);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -117,3 +117,23 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   plain.run(50);
   CHECK(plain.state_hash() != sim.state_hash());
 }
+
+TEST_CASE("magsim-scene NAME --write-scene FILE: the file runs to the registry run's state hash", "[tools]") {
+  const std::string dir = tmp_dir("write_scene");
+  const std::string file = dir + "_balls_up.json";
+  const Result w = run_scene("balls_up --write-scene " + file);
+  INFO(w.out);
+  REQUIRE(w.code == 0);
+  const Result a = run_scene("balls_up --steps 50 --no-render --out " + dir + "/registry");
+  const Result b = run_scene(file + " --steps 50 --no-render --out " + dir + "/file");
+  INFO(a.out << b.out);
+  REQUIRE(a.code == 0);
+  REQUIRE(b.code == 0);
+  std::ifstream fa(dir + "/registry/summary.json"), fb(dir + "/file/summary.json");
+  const auto ja = nlohmann::json::parse(fa), jb = nlohmann::json::parse(fb);
+  CHECK(jb["bodies"] == 244);
+  CHECK(jb["source"] == file);
+  CHECK(ja["state_hash"] == jb["state_hash"]);
+  CHECK(ja["options"] == jb["options"]);
+  std::remove(file.c_str());
+}
