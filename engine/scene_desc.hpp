@@ -156,6 +156,7 @@ struct SimOptions {
   int max_contacts = 4;            ///< per geom pair
   /// broad phase; sweep and prune: collide 2.3 vs 3.7 ms (hash) on sakura_tree, 2500 balls,
   /// same contacts (they are sorted into a fixed order), so the same state hash
+  /// (tests/engine/golden_hash_test.cpp checks sap, hash and simple)
   SpaceKind space = SpaceKind::SweepAndPrune;
   bool auto_disable = false;       ///< ODE auto-disable of resting bodies
   double linear_damping = 0.0;     ///< velocity decay rate c (1/s): v ← v·e^{−cΔt} per step; 0 = none
