@@ -487,8 +487,8 @@ struct SnapshotOpts {
   int threads = 1;        // OpenMP threads of the magnetics (0 = all)
 };
 
-/// OpenMP threads from here on (0 = all: the count before anything changed it). A Simulation
-/// sets its own count on every step, so call this again after stepping one.
+/// OpenMP threads from here on (0 = all: the count before anything changed it). A Simulation's
+/// step keeps its own count to itself (engine/step.cpp), so this holds across steps.
 void use_threads(int n) {
   static const int all = omp_get_max_threads();
   omp_set_num_threads(n > 0 ? n : all);
@@ -583,7 +583,6 @@ Snapshot sakura_snapshot(const SnapshotOpts& o, const std::string& out) {
   }
   const mag::MomentSet prev = sim.moments();
   sim.step();
-  use_threads(o.threads);
   const mag::MomentSet& now = sim.moments();
   if (now.size() != sn.warm.size()) throw std::runtime_error("snapshot: moment count differs");
   sn.warm.position = now.position;
