@@ -9,6 +9,7 @@
 #include "scenes/json_reader.hpp"
 #include "scenes/json_unique_keys.hpp"
 #include "scenes/options_json.hpp"
+#include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -30,7 +31,10 @@ using nlohmann::json;
 
 namespace {
 
-enum Exit { kOk = 0, kBadInput = 1, kRunFailed = 2, kIoError = 3 };
+using magsim::tools::kBadInput;
+using magsim::tools::kIoError;
+using magsim::tools::kOk;
+using magsim::tools::kRunFailed;
 
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -128,18 +132,11 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
-  app.footer(
-      "Exit codes: 0 done, 1 bad input or flags, 2 the solve failed, 3 the output could not be "
-      "written.\nThe Newton reference needs three dense 3N x 3N matrices for N induced moments; "
-      "above 2 GiB (N > 3153) magsolve refuses the case (exit 1).");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return kBadInput;
-  }
+  app.footer(magsim::tools::exit_codes_footer(
+      "bad input or flags", "the solve failed", "the output could not be written",
+      "The Newton reference needs three dense 3N x 3N matrices for N induced moments; above 2 GiB "
+      "(N > 3153) magsolve refuses the case (exit 1)."));
+  if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
 
   mag::DynamicsOptions opt;
   if (!mag::parse_method(method_name, &opt.method)) {
