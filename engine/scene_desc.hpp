@@ -115,9 +115,10 @@ struct SimOptions {
   /// update (Method::Ours) does not converge in weakly magnetized piles (balls_up: the cap
   /// every step, balls ejected), so the engine's default is the re-aligned one.
   mag::Method method = mag::Method::OursRealigned;
-  /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps at
-  /// max |ΔM|/Ms < 1e-4 or 100 sweeps per rigid step: warm-started from the last step, a
-  /// converging method needs a handful; a cap hit is counted in the profile.
+  /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps when the
+  /// residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::criterion, default Residual)
+  /// or after 100 sweeps per rigid step: warm-started from the last step, a converging method
+  /// needs a handful; a cap hit is counted in the profile.
   mag::DynamicsOptions magnetics = [] {
     mag::DynamicsOptions d;
     d.tol = 1e-4;
