@@ -34,8 +34,6 @@ std::string method_list(const char* sep) {
 
 namespace {
 
-json vec3(const engine::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
-
 SpaceKind space_kind(const JsonReader& r, const json& j, const std::string& path) {
   const std::string s = r.string(j, path);
   SpaceKind k;
@@ -76,7 +74,7 @@ json to_json(const SimOptions& o) {
   const mag::FieldOptions& f = o.magnetics.field;
   return json{{"method", mag::method_name(o.method)},
               {"dt", o.dt},
-              {"gravity", vec3(o.gravity)},
+              {"gravity", vec3_json(o.gravity)},
               {"ground", o.ground},
               {"friction", o.friction},
               {"restitution", o.restitution},

@@ -286,7 +286,6 @@ SceneDesc load_scene_file(const std::string& path) {
 // ---- writing (the inverse of the reader above: every field, so a scene reloads as it was) ----
 namespace {
 
-json vec3(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 json vec3f(const Eigen::Vector3f& v) { return json::array({v.x(), v.y(), v.z()}); }
 json quat(const Quat& q) { return json::array({q.w(), q.x(), q.y(), q.z()}); }
 
@@ -313,18 +312,18 @@ json shape_json(const ShapeDesc& sh) {
   json size;
   switch (sh.kind) {
     case ShapeKind::Sphere: size = json::array({sh.size.x()}); break;
-    case ShapeKind::Box: size = vec3(sh.size); break;
+    case ShapeKind::Box: size = vec3_json(sh.size); break;
     case ShapeKind::Capsule:
     case ShapeKind::Cylinder: size = json::array({sh.size.x(), sh.size.y()}); break;
   }
-  return json{{"kind", shape_kind_name(sh.kind)}, {"offset", vec3(sh.offset)}, {"rotation", quat(sh.rotation)},
+  return json{{"kind", shape_kind_name(sh.kind)}, {"offset", vec3_json(sh.offset)}, {"rotation", quat(sh.rotation)},
               {"size", size}};
 }
 
 json moment_json(const MomentDesc& m) {
-  json j{{"offset", vec3(m.offset)}, {"permanent", m.permanent}, {"volume", m.volume},
+  json j{{"offset", vec3_json(m.offset)}, {"permanent", m.permanent}, {"volume", m.volume},
          {"interaction_radius", m.interaction_radius}};
-  if (m.permanent) j["moment"] = vec3(m.moment);
+  if (m.permanent) j["moment"] = vec3_json(m.moment);
   else j["Ms"] = m.Ms;
   return j;
 }
@@ -335,10 +334,10 @@ json body_json(const BodyDesc& b) {
   for (const MomentDesc& m : b.moments) moments.push_back(moment_json(m));
   return json{{"name", b.name},
               {"type", body_type_name(b.type)},
-              {"position", vec3(b.position)},
+              {"position", vec3_json(b.position)},
               {"orientation", quat(b.orientation)},
-              {"velocity", vec3(b.velocity)},
-              {"angular_velocity", vec3(b.angular_velocity)},
+              {"velocity", vec3_json(b.velocity)},
+              {"angular_velocity", vec3_json(b.angular_velocity)},
               {"density", b.density},
               {"mass", b.mass},
               {"color", json::array({b.color.r, b.color.g, b.color.b})},
@@ -359,7 +358,7 @@ json scene_to_json(const SceneDesc& s) {
               {"modelling_level", s.modelling_level},
               {"default_seconds", s.default_seconds},
               {"escape_radius", s.escape_radius},
-              {"H0", vec3(s.H0)},
+              {"H0", vec3_json(s.H0)},
               {"camera",
                {{"eye", vec3f(c.eye)}, {"target", vec3f(c.target)}, {"up", vec3f(c.up)},
                 {"fov_y_deg", c.fov_y_deg}, {"z_near", c.z_near}, {"z_far", c.z_far}}},

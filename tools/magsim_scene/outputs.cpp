@@ -45,7 +45,6 @@ void prepare_out_dir(const std::string& dir) {
 }
 
 
-json vec3(const engine::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
 
 namespace {

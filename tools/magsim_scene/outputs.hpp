@@ -37,7 +37,6 @@ std::string csv_field(const std::string& v);
 // Creates DIR (and parents), checks that files can be written into it and deletes the
 // outputs of an earlier run there (only this program's own names, see is_output_name).
 void prepare_out_dir(const std::string& dir);
-json vec3(const engine::Vec3& v);
 // summary.json "energy" (outputs.cpp)
 json energy_json(const engine::Simulation& sim);
 
