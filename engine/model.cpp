@@ -14,7 +14,7 @@ namespace magsim::engine {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using mag::kPi;  // magnetics/types.hpp
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 bool finite(const Quat& q) { return q.coeffs().allFinite(); }

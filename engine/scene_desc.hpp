@@ -115,9 +115,10 @@ struct SimOptions {
   /// update (Method::Ours) does not converge in weakly magnetized piles (balls_up: the cap
   /// every step, balls ejected), so the engine's default is the re-aligned one.
   mag::Method method = mag::Method::OursRealigned;
-  /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps at
-  /// max |ΔM|/Ms < 1e-4 or 100 sweeps per rigid step: warm-started from the last step, a
-  /// converging method needs a handful; a cap hit is counted in the profile.
+  /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps when the
+  /// residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::criterion, default Residual)
+  /// or after 100 sweeps per rigid step: warm-started from the last step, a converging method
+  /// needs a handful; a cap hit is counted in the profile.
   mag::DynamicsOptions magnetics = [] {
     mag::DynamicsOptions d;
     d.tol = 1e-4;
@@ -156,6 +157,7 @@ struct SimOptions {
   int max_contacts = 4;            ///< per geom pair
   /// broad phase; sweep and prune: collide 2.3 vs 3.7 ms (hash) on sakura_tree, 2500 balls,
   /// same contacts (they are sorted into a fixed order), so the same state hash
+  /// (tests/engine/golden_hash_test.cpp checks sap, hash and simple)
   SpaceKind space = SpaceKind::SweepAndPrune;
   bool auto_disable = false;       ///< ODE auto-disable of resting bodies
   double linear_damping = 0.0;     ///< velocity decay rate c (1/s): v ← v·e^{−cΔt} per step; 0 = none

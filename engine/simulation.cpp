@@ -30,7 +30,7 @@ int default_omp_threads() {
 Simulation::Simulation(const SceneDesc& scene)
     : model_(std::make_unique<const Model>(compile_model(scene))) {
   const Model& m = *model_;
-  const int all_threads = default_omp_threads();  // captured before any step changes it
+  const int all_threads = default_omp_threads();  // the count at the first Simulation
   state_ = initial_state(m);
   moments_ = make_moment_set(m);
   load_magnetization(state_, &moments_);

@@ -21,13 +21,31 @@
 
 namespace magsim::engine {
 
+namespace {
+
+// The engine's OpenMP thread count for the span of one step: the caller's count
+// (omp_get_max_threads of the calling thread) is back when the step returns or throws, so a
+// Simulation with its own `threads` does not change the threads of the caller's own regions.
+class OmpThreadScope {
+ public:
+  explicit OmpThreadScope(int threads) : saved_(omp_get_max_threads()) { omp_set_num_threads(threads); }
+  ~OmpThreadScope() { omp_set_num_threads(saved_); }
+  OmpThreadScope(const OmpThreadScope&) = delete;
+  OmpThreadScope& operator=(const OmpThreadScope&) = delete;
+
+ private:
+  int saved_;
+};
+
+}  // namespace
+
 void Simulation::step() {
   const Model& m = *model_;
   profile_ = StepProfile{};
   StepProfile& prof = profile_;
   ScopedTimer total(&prof.total_ms);
   const long n = state_.step + 1;  // the step being taken, as named in errors
-  omp_set_num_threads(omp_threads_);  // per calling thread; several Simulations may differ
+  const OmpThreadScope threads(omp_threads_);  // several Simulations may differ
 
   // energy audit (energy.hpp) of this step, committed with the state
   begin_audit_step(energy_, &ws_.audit);

@@ -26,9 +26,7 @@ struct FieldOptions {
   /// pair force grows as 1/|r|⁴ and steeper). Exact for every pair at or beyond contact.
   /// No effect where every radius is 0 (magsolve, the experiments' point moments).
   /// Off by default: inside an overlap the force is frozen at its contact value, which is not
-  /// a gradient, and in balls_up's resting pile that pumped energy (2 s: final KE 3.5e-5 →
-  /// 0.38 J, 5 balls flung past 1 m), while in falling_magnet it cut the balls beyond 1 m
-  /// only from 52 to 43 (issue #12's note).
+  /// a gradient, and in balls_up's resting pile that pumped energy (README, "Benchmarks").
   bool bounded_pairs = false;
   /// Auto (the default): the exact direct sum below auto_threshold moments, Barnes–Hut
   /// (relative field error RMS ≤ 1e-3) from there on. Direct forces the exact sum.
@@ -36,15 +34,11 @@ struct FieldOptions {
   /// Barnes–Hut opening angle θ ∈ [0, 1]: a cell of radius b (about its expansion centre)
   /// at distance R from a group of targets of radius b_t is used whole when b < θ (R − b_t).
   /// 0 = never (the direct sum, through the tree). 0.3: relative field error RMS ≤ 1e-3,
-  /// max ≤ 2e-2 on piles and clouds; on flat sheets the max reaches 0.5 at the few balls
-  /// where |H| nearly cancels (measured, barnes_hut.hpp).
+  /// max ≤ 2e-2 on piles and clouds (barnes_hut.hpp).
   double bh_theta = 0.3;
-  /// Auto uses Barnes–Hut from this many moments on. With the geometry reused across a
-  /// step's evaluations and the single-precision near field, Barnes–Hut already wins at
-  /// ~1,000 moments in the engine (falling_magnet, 1,033 moments, anderson, 2 threads:
-  /// T_i + T_f 2.75 ms against 3.75 ms direct); 2,000 keeps the exact sum for the scenes
-  /// and experiments up to that size, and takes Barnes–Hut for sakura_tree (2,508 moments:
-  /// 6.7 ms against 18.8 ms).
+  /// Auto uses Barnes–Hut from this many moments on: 2,000 keeps the exact sum for the
+  /// scenes and experiments up to that size and takes Barnes–Hut for sakura_tree (2,508
+  /// moments); the crossover measured in the engine: README, "Benchmarks".
   int auto_threshold = 2000;
   /// Barnes–Hut leaf size (at most this many moments per octree leaf), ≥ 1. Cells of a few
   /// moments are poor multipoles; leaves of 64 are both faster and ~10× more accurate than
@@ -56,16 +50,14 @@ struct FieldOptions {
   /// term, 2 = also the octupole-order term (error ∝ (b/R)^(order+1) per cell).
   int bh_order = 2;
   /// Barnes–Hut near field (the exact pair sums over near leaves, most of its time) in
-  /// single precision, positions relative to the target group's centre: the pair kernel
-  /// ~2× faster (an evaluation 1.5–1.8×), adds < 1e-6 to the relative field error RMS
-  /// (< 1.5e-6 to J's; measured, barnes_hut.hpp). Only with θ > 0 (θ = 0 promises the
+  /// single precision, positions relative to the target group's centre: adds < 2e-6 to the
+  /// relative RMS of H and J (barnes_hut.hpp). Only with θ > 0 (θ = 0 promises the
   /// direct sum and stays in double). false: the near field in double — and the far cells
   /// too (bh_far_float applies only with bh_near_float), so false is the all-double sum.
   bool bh_near_float = true;
   /// With bh_near_float (and θ > 0): the far-cell Taylor sums in single precision too
   /// (cell data relative to the target group's centre, scaled; partial sums added in
-  /// double): an evaluation 1.1–1.25× faster, adds ≤ 3e-7 to the relative RMS of H and J
-  /// (measured, barnes_hut.hpp).
+  /// double): adds < 1e-5 to the relative RMS of H and J (barnes_hut.hpp).
   /// false: far cells in double (the near field as bh_near_float says).
   bool bh_far_float = true;
 };

@@ -19,7 +19,7 @@ using engine::Quat;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using mag::kPi;  // magnetics/types.hpp
 constexpr double kIronMs = 1.6e6;        // saturation magnetization of iron (A/m)
 constexpr double kIronDensity = 7870.0;  // (kg/m³)
 constexpr double kNdFeBM = 1.0e6;        // magnetization of a neodymium magnet, Br ≈ 1.26 T (A/m)
@@ -30,6 +30,31 @@ const render::Color kIron{0.55f, 0.56f, 0.58f};
 const render::Color kMagnetRed{0.80f, 0.12f, 0.12f};
 
 double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }
+
+/// A permanent moment m (A·m², body frame) standing for `volume` of magnet, at `offset`.
+MomentDesc permanent_moment(double volume, const Vec3& m, const Vec3& offset = Vec3::Zero()) {
+  MomentDesc d;
+  d.permanent = true;
+  d.offset = offset;
+  d.volume = volume;
+  d.moment = m;
+  return d;
+}
+
+/// A magnet body: one shape (at its origin), the given permanent moments, coloured as a
+/// magnet and counted as "the magnet" by the attachment metrics.
+BodyDesc magnet_body(const std::string& name, BodyType type, const Vec3& p, ShapeKind kind,
+                     const Vec3& size, std::vector<MomentDesc> moments) {
+  BodyDesc b;
+  b.name = name;
+  b.type = type;
+  b.magnet = true;
+  b.position = p;
+  b.shapes.push_back({kind, Vec3::Zero(), Quat::Identity(), size});
+  b.moments = std::move(moments);
+  b.color = kMagnetRed;
+  return b;
+}
 
 /// An iron ball: one sphere, one induced moment at its centre (modelling level: 1 moment).
 BodyDesc iron_ball(const std::string& name, const Vec3& p, double r) {
@@ -61,6 +86,11 @@ void stack_balls(SceneDesc* s, int N, int side, double r, double gap, double cx,
 }
 
 // ---------------------------------------------------------------------------------------
+// gap between stacked balls, a fraction of the diameter: they start apart, not in contact
+constexpr double kStackGap = 0.001;
+constexpr int kBallsUpSide = 9;    // balls per row (9 × 9 per layer, the paper's 9×9×3)
+constexpr int kBallsUpLayers = 3;  // the paper's layers: the magnet's height is set from them
+
 // balls_up — 243 iron balls (9×9×3, radius 5 mm) resting on frictionless ground; a 2 cm
 // neodymium cube magnet fixed 3 cm above the top layer pulls them up.
 SceneDesc balls_up(const SceneParams& p) {
@@ -72,21 +102,14 @@ SceneDesc balls_up(const SceneParams& p) {
       "permanent moment at its centre; no friction";
   const int N = p.count > 0 ? p.count : 243;
   const double r = 0.005;
-  stack_balls(&s, N, 9, r, 0.001, 0, 0);
+  stack_balls(&s, N, kBallsUpSide, r, kStackGap, 0, 0);
   const double L = 0.02;  // cube side (m)
-  BodyDesc mag;
-  mag.name = "magnet";
-  mag.type = BodyType::Static;
-  mag.magnet = true;
-  mag.position = Vec3(0, 0, 3 * 2 * r + 0.03 + L / 2);
-  mag.shapes.push_back({ShapeKind::Box, Vec3::Zero(), Quat::Identity(), Vec3(L / 2, L / 2, L / 2)});
-  MomentDesc m;
-  m.permanent = true;
-  m.volume = L * L * L;
-  m.moment = Vec3(0, 0, kNdFeBM * L * L * L * p.strength);  // 8 A·m², pointing up
-  mag.moments.push_back(m);
-  mag.color = kMagnetRed;
-  s.bodies.push_back(mag);
+  // the magnet's face 3 cm above the paper's 3 layers (--count leaves it there: fewer balls
+  // only lie lower, and the stress sweep's 54 balls keep their measured setting)
+  const double face = kBallsUpLayers * 2 * r + 0.03;  // (m)
+  s.bodies.push_back(magnet_body("magnet", BodyType::Static, Vec3(0, 0, face + L / 2), ShapeKind::Box,
+                                 Vec3(L / 2, L / 2, L / 2),
+                                 {permanent_moment(L * L * L, Vec3(0, 0, kNdFeBM * L * L * L * p.strength))}));  // 8 A·m², up
   s.options.friction = 0.0;
   s.options.quickstep_iterations = 100;
   s.camera.eye = Eigen::Vector3f(0.16f, -0.20f, 0.12f);
@@ -100,7 +123,7 @@ SceneDesc balls_up(const SceneParams& p) {
 // ---------------------------------------------------------------------------------------
 // alphabets — 100 letter pieces (iron, 3 cm tall, 5 mm strokes, 1 induced moment per
 // stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible 30 A·m² moment at
-// the grid centre with an invisible 2 cm collider (|H| ≈ 0.26 Ms on the axis where a stroke
+// the grid centre with an invisible collider of radius 2 cm (|H| ≈ 0.26 Ms on the axis where a stroke
 // lies on the collider, its moment 2.25 cm from the centre). The paper's "excessively strong"
 // 300 A·m² (--strength 10: 2.6 Ms there, where Fig. 9 has Kim 2018 fail) blows up with every
 // force model in a 1 ms frame: ours-realigned 1267 m/s at step 300, with the classic force
@@ -156,28 +179,24 @@ SceneDesc alphabets(const SceneParams& p) {
   s.description = "100 iron letters in mid-air gathered by an invisible, excessively strong moment";
   s.modelling_level =
       "letters = 1–4 boxes, 1 induced moment per box; central moment: static, invisible, "
-      "with an invisible sphere collider of 1.5 cm; no gravity, no ground";
+      "with an invisible sphere collider of radius 2 cm; no gravity, no ground";
   const int N = p.count > 0 ? p.count : 100;
-  const double pitch = 0.07;
+  const double pitch = 0.07;  // (m) grid pitch: letters 3 cm tall start 4 cm apart
+  // beyond 100 letters (--count) the grid repeats, each repeat 2 cm higher
+  const double repeat_shift = 0.02;  // (m)
   std::mt19937 rng(2018);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int k = 0; k < N; ++k) {
     const int i = k % 5, j = (k / 5) % 5, l = (k / 25) % 4, extra = k / 100;
-    const Vec3 pos((i - 2) * pitch, (j - 2) * pitch, (l - 1.5) * pitch + extra * 0.02);
+    const Vec3 pos((i - 2) * pitch, (j - 2) * pitch, (l - 1.5) * pitch + extra * repeat_shift);
     const Quat q = Quat(Eigen::AngleAxisd(kPi * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
     s.bodies.push_back(letter(k, pos, q));
   }
-  BodyDesc c;
-  c.name = "centre";
-  c.type = BodyType::Static;
-  c.magnet = true;
+  const double Rc = 0.02;  // (m) radius of the invisible collider around the central moment
+  BodyDesc c = magnet_body("centre", BodyType::Static, Vec3::Zero(), ShapeKind::Sphere, Vec3(Rc, Rc, Rc),
+                           {permanent_moment(sphere_volume(Rc), Vec3(0, 0, 30.0 * p.strength))});
   c.visible = false;
-  c.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(0.02, 0.02, 0.02)});
-  MomentDesc m;
-  m.permanent = true;
-  m.volume = sphere_volume(0.02);
-  m.moment = Vec3(0, 0, 30.0 * p.strength);
-  c.moments.push_back(m);
+  c.color = BodyDesc{}.color;  // never drawn
   s.bodies.push_back(c);
   s.options.gravity = Vec3::Zero();
   s.options.ground = false;
@@ -206,22 +225,17 @@ SceneDesc falling_magnet(const SceneParams& p) {
       "it from the balls' field)";
   const int N = p.count > 0 ? p.count : 1032;
   const double r = 0.005;
-  stack_balls(&s, N, 12, r, 0.001, 0, 0);
-  const int layers = (N + 143) / 144;
-  const double top = layers * 2 * r * 1.001;
+  const int side = 12;  // balls per row, 144 per layer
+  stack_balls(&s, N, side, r, kStackGap, 0, 0);
+  const int layers = (N + side * side - 1) / (side * side);
+  const double top = layers * 2 * r * (1.0 + kStackGap);
   const double R = 0.02;
-  BodyDesc mag;
-  mag.name = "magnet";
-  mag.magnet = true;
-  mag.position = Vec3(0.004, -0.003, top + 0.08 + R);
+  // 8 cm above the pile, a few mm off the central column: it lands between balls, not on
+  // one ball's top (a symmetric landing would be a knife-edge start)
+  const Vec3 drop(0.004, -0.003, top + 0.08 + R);  // (m)
+  BodyDesc mag = magnet_body("magnet", BodyType::Dynamic, drop, ShapeKind::Sphere, Vec3(R, R, R),
+                             {permanent_moment(sphere_volume(R), Vec3(0, 0, -kNdFeBM * sphere_volume(R) * p.strength))});  // pointing down
   mag.density = 7500.0;  // NdFeB (kg/m³)
-  mag.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(R, R, R)});
-  MomentDesc m;
-  m.permanent = true;
-  m.volume = sphere_volume(R);
-  m.moment = Vec3(0, 0, -kNdFeBM * sphere_volume(R) * p.strength);  // pointing down
-  mag.moments.push_back(m);
-  mag.color = kMagnetRed;
   s.bodies.push_back(mag);
   // a dynamic magnet: eq. 4's forces do not balance pairwise, and the magnet with the balls
   // on it would propel itself (200 m/s within 1 s); apply them pairwise antisymmetrized
@@ -267,34 +281,30 @@ SceneDesc sakura_tree(const SceneParams& p) {
     sh.size = Vec3(rad, 0.5 * d.norm(), 0);
     tree.shapes.push_back(sh);
   };
+  // the tree (m, rad): a 16 cm trunk (radius 12 mm) forks into 4 branches (7 mm) that reach
+  // 7 cm out and 7 cm up, turned 0.3 rad so none lies along x or y (the sheet of balls above
+  // is aligned with them); each ends in 2 twigs (4 mm) 6 cm out and 5 cm up, ±0.45 rad apart
   const Vec3 base(0, 0, 0), fork(0, 0, 0.16);
-  capsule(base, fork, 0.012);
+  const double trunk_r = 0.012, branch_r = 0.007, twig_r = 0.004;
+  const double branch_turn = 0.3, branch_out = 0.07, branch_up = 0.07;
+  const double twig_spread = 0.45, twig_out = 0.06, twig_up = 0.05;
+  capsule(base, fork, trunk_r);
   for (int i = 0; i < 4; ++i) {
-    const double a = kPi / 2 * i + 0.3;
-    const Vec3 mid = fork + Vec3(0.07 * std::cos(a), 0.07 * std::sin(a), 0.07);
-    capsule(fork, mid, 0.007);
+    const double a = kPi / 2 * i + branch_turn;
+    const Vec3 mid = fork + Vec3(branch_out * std::cos(a), branch_out * std::sin(a), branch_up);
+    capsule(fork, mid, branch_r);
     for (int k = -1; k <= 1; k += 2) {
-      const double b = a + 0.45 * k;
-      const Vec3 tip = mid + Vec3(0.06 * std::cos(b), 0.06 * std::sin(b), 0.05);
-      capsule(mid, tip, 0.004);
+      const double b = a + twig_spread * k;
+      const Vec3 tip = mid + Vec3(twig_out * std::cos(b), twig_out * std::sin(b), twig_up);
+      capsule(mid, tip, twig_r);
       // the branch end: a NdFeB sphere magnet of radius Rt magnetized along the branch, a
       // static body of its own (coloured as a magnet). Its collider keeps iron at ≥ Rt + r
       // from the dipole: a 20 A·m² point moment on a 4 mm twig let a ball reach 8 mm from
       // it (|H| ≈ 4 Ms, ≈ 1 kN on a 2 g ball), which no 1 ms rigid step resolves.
       const double Rt = 0.012;  // (m)
-      BodyDesc tipm;
-      tipm.name = "tip_magnet_" + std::to_string(tips.size());
-      tipm.type = BodyType::Static;
-      tipm.magnet = true;
-      tipm.position = tip;
-      tipm.color = kMagnetRed;
-      tipm.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(Rt, Rt, Rt)});
-      MomentDesc m;
-      m.permanent = true;
-      m.volume = sphere_volume(Rt);
-      m.moment = kNdFeBM * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 7.2 A·m²
-      tipm.moments.push_back(m);
-      tips.push_back(tipm);
+      const Vec3 m = kNdFeBM * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 7.2 A·m²
+      tips.push_back(magnet_body("tip_magnet_" + std::to_string(tips.size()), BodyType::Static, tip,
+                                 ShapeKind::Sphere, Vec3(Rt, Rt, Rt), {permanent_moment(sphere_volume(Rt), m)}));
     }
   }
   s.bodies.push_back(tree);
@@ -306,9 +316,14 @@ SceneDesc sakura_tree(const SceneParams& p) {
   for (int k = 0; k < N; ++k) {
     const int layer = k / (side * side), in = k % (side * side);
     const int i = in % side, j = in / side;
-    const double pitch = 0.011;
-    const Vec3 pos((i - 0.5 * (side - 1)) * pitch + 0.0013 * (j % 3),
-                   (j - 0.5 * (side - 1)) * pitch, 0.40 + layer * 0.03);
+    const double pitch = 0.011;        // (m) 3 mm between 8 mm balls
+    // rows shifted by 0, 1.3, 2.6 mm in turn: a sheet aligned with nothing below, so the
+    // balls do not land in lock-step columns on the twigs
+    const double row_shift = 0.0013;   // (m)
+    const double drop_height = 0.40;   // (m) above the ground, 14 cm above the twig ends
+    const double sheet_gap = 0.03;     // (m) between sheets beyond side² balls (--count)
+    const Vec3 pos((i - 0.5 * (side - 1)) * pitch + row_shift * (j % 3),
+                   (j - 0.5 * (side - 1)) * pitch, drop_height + layer * sheet_gap);
     s.bodies.push_back(iron_ball("ball_" + std::to_string(k), pos, r));
   }
   s.options.rolling_friction = kRollingCoefficient * r;  // as falling_magnet: balls can rest
@@ -324,7 +339,9 @@ SceneDesc sakura_tree(const SceneParams& p) {
 // ---------------------------------------------------------------------------------------
 // crystal_balls — 178 fixed iron balls (radius 5 mm) on a sphere of radius 5 cm (Fibonacci
 // lattice) around a 6 cm bar magnet of 3 permanent moments. strength 1 = the strong magnet
-// (4000 A·m² in all, |H| up to ≈ 4 Ms at the poles); the weak magnet is strength 0.05.
+// (4000 A·m² in all; |H| up to 6.1 Ms at the balls nearest the poles, at the ground truth);
+// the weak magnet is strength 0.05 (|H| up to 0.24 Ms). Measured: experiments fig8,
+// fig8.json's max_H_over_Ms.
 SceneDesc crystal_balls(const SceneParams& p) {
   SceneDesc s;
   s.name = "crystal_balls";
@@ -334,31 +351,21 @@ SceneDesc crystal_balls(const SceneParams& p) {
       "bar magnet: static box with 3 permanent moments along its axis";
   const int N = p.count > 0 ? p.count : 178;
   const double r = 0.005, R = 0.05;
+  const Vec3 centre(0, 0, 0.1);  // (m) the bar's centre, above the (unused) ground
   const double golden = kPi * (3.0 - std::sqrt(5.0));
   for (int k = 0; k < N; ++k) {
     const double z = 1.0 - 2.0 * (k + 0.5) / N;
     const double rho = std::sqrt(1.0 - z * z);
     const Vec3 pos(R * rho * std::cos(golden * k), R * rho * std::sin(golden * k), R * z);
-    BodyDesc b = iron_ball("ball_" + std::to_string(k), pos + Vec3(0, 0, 0.1), r);
+    BodyDesc b = iron_ball("ball_" + std::to_string(k), pos + centre, r);
     b.type = BodyType::Static;
     s.bodies.push_back(b);
   }
-  BodyDesc bar;
-  bar.name = "bar_magnet";
-  bar.type = BodyType::Static;
-  bar.magnet = true;
-  bar.position = Vec3(0, 0, 0.1);
-  bar.shapes.push_back({ShapeKind::Box, Vec3::Zero(), Quat::Identity(), Vec3(0.006, 0.006, 0.03)});
-  for (int k = -1; k <= 1; ++k) {
-    MomentDesc m;
-    m.permanent = true;
-    m.offset = Vec3(0, 0, 0.02 * k);
-    m.volume = 0.012 * 0.012 * 0.02;
-    m.moment = Vec3(0, 0, 4000.0 / 3.0 * p.strength);
-    bar.moments.push_back(m);
-  }
-  bar.color = kMagnetRed;
-  s.bodies.push_back(bar);
+  // the bar: 12 × 12 × 60 mm, one moment per third of it at the third's centre
+  std::vector<MomentDesc> thirds;
+  for (int k = -1; k <= 1; ++k)
+    thirds.push_back(permanent_moment(0.012 * 0.012 * 0.02, Vec3(0, 0, 4000.0 / 3.0 * p.strength), Vec3(0, 0, 0.02 * k)));
+  s.bodies.push_back(magnet_body("bar_magnet", BodyType::Static, centre, ShapeKind::Box, Vec3(0.006, 0.006, 0.03), thirds));
   s.options.gravity = Vec3::Zero();
   s.camera.eye = Eigen::Vector3f(0.12f, -0.16f, 0.16f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.1f);

@@ -6,7 +6,10 @@
 // (non-finite solution), 3 I/O error (the output could not be written).
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
+#include "scenes/json_reader.hpp"
 #include "scenes/json_unique_keys.hpp"
+#include "scenes/options_json.hpp"
+#include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -28,79 +31,52 @@ using nlohmann::json;
 
 namespace {
 
-enum Exit { kOk = 0, kBadInput = 1, kRunFailed = 2, kIoError = 3 };
+using magsim::tools::kBadInput;
+using magsim::tools::kIoError;
+using magsim::tools::kOk;
+using magsim::tools::kRunFailed;
 
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-Vec3 read_vec3(const json& j, const std::string& where) {
-  if (!j.is_array() || j.size() != 3)
-    throw InputError(where + ": must be an array of 3 numbers");
-  Vec3 v;
-  for (int k = 0; k < 3; ++k) {
-    if (!j[k].is_number()) throw InputError(where + ": must be an array of 3 numbers");
-    v[k] = j[k].get<double>();
-    if (!std::isfinite(v[k])) throw InputError(where + ": is not finite");
-  }
-  return v;
-}
-
-double read_positive(const json& obj, const char* key, const std::string& where) {
-  if (!obj.contains(key)) throw InputError(where + "." + key + ": missing");
-  const json& j = obj[key];
-  if (!j.is_number()) throw InputError(where + "." + key + ": must be a number");
-  const double v = j.get<double>();
-  if (!std::isfinite(v)) throw InputError(where + "." + key + ": is not finite");
-  if (v <= 0) throw InputError(where + "." + key + ": must be > 0, got " + j.dump());
-  return v;
-}
-
-void check_keys(const json& obj, std::initializer_list<const char*> allowed,
-                const std::string& where) {
-  for (auto it = obj.begin(); it != obj.end(); ++it) {
-    bool ok = false;
-    for (const char* a : allowed) ok = ok || it.key() == a;
-    if (!ok) throw InputError(where + ": unknown key \"" + it.key() + "\"");
-  }
-}
-
-mag::MomentSet parse_case(const json& doc, double softening) {
-  if (!doc.is_object()) throw InputError("top level: must be an object");
-  check_keys(doc, {"external_field", "moments"}, "top level");
+// The case file, read with the scene files' checked reader (scenes/json_reader.hpp): every
+// error is "<file>: <json path>: <what>". "magnetics" (optional) is a scene file's
+// options.magnetics, read by the same from_json (scenes/options_json.hpp).
+mag::MomentSet parse_moments(const magsim::scenes::JsonReader& r, const json& doc, double softening) {
   mag::MomentSet set;
-  if (doc.contains("external_field")) set.H0 = read_vec3(doc["external_field"], "external_field");
-  if (!doc.contains("moments")) throw InputError("moments: missing");
+  if (doc.contains("external_field")) set.H0 = r.vec3(doc["external_field"], "external_field");
+  if (!doc.contains("moments")) r.fail("moments", "missing (a non-empty array of moments)");
   const json& ms = doc["moments"];
-  if (!ms.is_array() || ms.empty()) throw InputError("moments: must be a non-empty array");
+  if (!ms.is_array() || ms.empty()) r.fail("moments", "must be a non-empty array");
   for (std::size_t i = 0; i < ms.size(); ++i) {
-    const std::string w = "moments[" + std::to_string(i) + "]";
+    const std::string w = magsim::scenes::JsonReader::index("moments", i);
     const json& m = ms[i];
-    if (!m.is_object()) throw InputError(w + ": must be an object");
-    if (!m.contains("kind") || !m["kind"].is_string())
-      throw InputError(w + ".kind: missing (\"induced\" or \"permanent\")");
+    r.object(m, w);
+    if (!m.contains("kind") || !m["kind"].is_string()) r.fail(w + ".kind", "missing (\"induced\" or \"permanent\")");
     const std::string kind = m["kind"].get<std::string>();
-    if (!m.contains("position")) throw InputError(w + ".position: missing");
-    const Vec3 p = read_vec3(m["position"], w + ".position");
-    const double V = read_positive(m, "volume", w);
+    if (!m.contains("position")) r.fail(w + ".position", "missing");
+    const Vec3 p = r.vec3(m["position"], w + ".position");
+    if (!m.contains("volume")) r.fail(w + ".volume", "missing");
+    const double V = r.positive(m["volume"], w + ".volume");
     if (kind == "induced") {
-      check_keys(m, {"position", "volume", "Ms", "kind"}, w);
-      set.add_induced(p, V, read_positive(m, "Ms", w));
+      r.keys(m, w, {"position", "volume", "Ms", "kind"});
+      if (!m.contains("Ms")) r.fail(w + ".Ms", "missing");
+      set.add_induced(p, V, r.positive(m["Ms"], w + ".Ms"));
     } else if (kind == "permanent") {
-      check_keys(m, {"position", "volume", "moment", "kind"}, w);
-      if (!m.contains("moment")) throw InputError(w + ".moment: missing");
-      set.add_permanent(p, V, read_vec3(m["moment"], w + ".moment"));
+      r.keys(m, w, {"position", "volume", "moment", "kind"});
+      if (!m.contains("moment")) r.fail(w + ".moment", "missing");
+      set.add_permanent(p, V, r.vec3(m["moment"], w + ".moment"));
     } else {
-      throw InputError(w + ".kind: must be \"induced\" or \"permanent\", got \"" + kind + "\"");
+      r.fail(w + ".kind", "must be \"induced\" or \"permanent\", got \"" + kind + "\"");
     }
   }
   if (softening == 0.0) {
     for (std::size_t i = 0; i < set.size(); ++i)
       for (std::size_t j = 0; j < i; ++j)
         if (set.position[i] == set.position[j])
-          throw InputError("moments[" + std::to_string(j) + "] and moments[" +
-                           std::to_string(i) +
-                           "] are at the same point; give --softening EPS to allow it");
+          r.fail("", "moments[" + std::to_string(j) + "] and moments[" + std::to_string(i) +
+                         "] are at the same point; give --softening EPS to allow it");
   }
   return set;
 }
@@ -142,10 +118,11 @@ int run(int argc, char** argv) {
   std::string path, method_name = "ours", format = "json";
   double dt = 100e-9, tol = 1e-6, softening = 0.0;
   int max_iter = 999;
-  app.add_option("case", path, "CASE.json: {\"external_field\": [Hx,Hy,Hz], \"moments\": [...]}")
+  app.add_option("case", path,
+                 "CASE.json: {\"external_field\": [Hx,Hy,Hz], \"moments\": [...], \"magnetics\": {...}} "
+                 "(magnetics: a scene file's options.magnetics; the flags below override it)")
       ->required();
-  app.add_option("--method", method_name, "ours|ours-realigned|kim2018|damping-llg|exact|anderson")
-      ->capture_default_str();
+  app.add_option("--method", method_name, magsim::scenes::method_list("|"))->capture_default_str();
   app.add_option("--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6]")
       ->capture_default_str();
   app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration")
@@ -155,34 +132,18 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
-  app.footer(
-      "Exit codes: 0 done, 1 bad input or flags, 2 the solve failed, 3 the output could not be "
-      "written.\nThe Newton reference needs three dense 3N x 3N matrices for N induced moments; "
-      "above 2 GiB (N > 3153) magsolve refuses the case (exit 1).");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return kBadInput;
-  }
+  app.footer(magsim::tools::exit_codes_footer(
+      "bad input or flags", "the solve failed", "the output could not be written",
+      "The Newton reference needs three dense 3N x 3N matrices for N induced moments; above 2 GiB "
+      "(N > 3153) magsolve refuses the case (exit 1)."));
+  if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
 
   mag::DynamicsOptions opt;
   if (!mag::parse_method(method_name, &opt.method)) {
-    std::fprintf(stderr, "magsolve: unknown method '%s' (ours, ours-realigned, kim2018, "
-                         "damping-llg, exact, anderson)\n", method_name.c_str());
+    std::fprintf(stderr, "magsolve: unknown method '%s' (%s)\n", method_name.c_str(),
+                 magsim::scenes::method_list().c_str());
     return kBadInput;
   }
-  opt.dt = dt;
-  opt.tol = tol;
-  opt.max_iter = max_iter;
-  opt.field.softening = softening;
-  if (const std::string e = mag::validate(opt); !e.empty()) {
-    std::fprintf(stderr, "magsolve: %s\n", e.c_str());
-    return kBadInput;
-  }
-
   mag::MomentSet set;
   try {
     const std::string text = read_text(path);
@@ -194,7 +155,19 @@ int run(int argc, char** argv) {
     } catch (const json::exception& e) {  // syntax errors and numbers out of range
       throw InputError(std::string("malformed JSON: ") + e.what());
     }
-    set = parse_case(doc, softening);
+    const magsim::scenes::JsonReader r(path);
+    r.keys(doc, "", {"external_field", "moments", "magnetics"});
+    if (doc.contains("magnetics")) magsim::scenes::from_json(r, doc["magnetics"], "magnetics", &opt);
+    // flags given on the command line override the case's "magnetics"
+    if (app.count("--dt")) opt.dt = dt;
+    if (app.count("--tol")) opt.tol = tol;
+    if (app.count("--max-iter")) opt.max_iter = max_iter;
+    if (app.count("--softening")) opt.field.softening = softening;
+    if (const std::string e = mag::validate(opt); !e.empty()) {
+      std::fprintf(stderr, "magsolve: %s\n", e.c_str());
+      return kBadInput;
+    }
+    set = parse_moments(r, doc, opt.field.softening);
     std::size_t induced = 0;
     for (std::size_t j = 0; j < set.size(); ++j) induced += set.kind[j] == mag::MomentKind::Induced;
     if (reference_bytes(induced) > kReferenceBytesMax) {
@@ -209,6 +182,9 @@ int run(int argc, char** argv) {
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "magsolve: %s: %s\n", path.c_str(), e.what());
+    return kBadInput;
+  } catch (const std::runtime_error& e) {  // JsonReader: "<file>: <json path>: <what>"
+    std::fprintf(stderr, "magsolve: %s\n", e.what());
     return kBadInput;
   }
 

@@ -16,7 +16,7 @@ using engine::ShapeDesc;
 using engine::ShapeKind;
 using engine::Vec3;
 
-inline constexpr double kPi = 3.14159265358979323846;
+using mag::kPi;  // magnetics/types.hpp
 inline constexpr double kR = 0.005;  // ball radius (m)
 
 inline double sphere_volume(double r) { return 4.0 / 3.0 * kPi * r * r * r; }

@@ -3,6 +3,7 @@
 #include "fixtures.hpp"
 
 #include <catch2/catch.hpp>
+#include <omp.h>
 
 using namespace magsim;
 using namespace magsim::test;
@@ -206,4 +207,18 @@ TEST_CASE("step: speculative contacts stop a fast ball at a thin plate", "[step]
     sim.run(20);
     CHECK(sim.body_position(1).z() > 0.1);
   }
+}
+
+TEST_CASE("step: the engine's thread count does not leak into the caller's OpenMP setting", "[step]") {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(3);
+  for (int threads : {1, 2}) {
+    SceneDesc s = pile_under_magnet(3, 2.0);
+    s.options.threads = threads;
+    engine::Simulation sim(s);
+    sim.run(3);
+    INFO("Simulation threads " << threads);
+    CHECK(omp_get_max_threads() == 3);  // 1 or 2 before the step scoped it
+  }
+  omp_set_num_threads(before);
 }

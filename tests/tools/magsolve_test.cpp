@@ -85,3 +85,19 @@ TEST_CASE("magsolve rejects bad input with a one-line error and a non-zero exit"
   CHECK(run(write_tmp("soft", "{\"moments\": [" + b + "," + b + "]}") + " --softening 0.001")
             .code == 0);
 }
+
+TEST_CASE("magsolve: the case's \"magnetics\" is a scene file's options.magnetics, and flags override it", "[tools]") {
+  const std::string two = std::string("{\"external_field\": [0, 0, 1000], \"moments\": [") + kBall +
+                          R"(, {"position": [0, 0, 0.0101], "volume": 5e-7, "Ms": 1.6e6, "kind": "induced"}],)";
+  const std::string path = write_tmp("magnetics", two + R"( "magnetics": {"max_iter": 2, "tol": 1e-12}})");
+  const Result r = run(path + " --method ours");
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(nlohmann::json::parse(r.out)["iterations"] == 2);
+  const Result o = run(path + " --method ours --max-iter 3");
+  REQUIRE(o.code == 0);
+  CHECK(nlohmann::json::parse(o.out)["iterations"] == 3);
+  const Result bad = run(write_tmp("magnetics_bad", two + R"( "magnetics": {"dt_m": 1e-7}})"));
+  CHECK(bad.code == 1);
+  CHECK(bad.out.find("magnetics.dt_m: unknown key") != std::string::npos);
+}

@@ -1,10 +1,14 @@
-// Tests for tools/magsim_scene.cpp: the ODE flags (--space, --quickstep-iterations,
+// Tests for tools/magsim_scene/ (magsim-scene): the ODE flags (--space, --quickstep-iterations,
 // --auto-disable) reach the run, and bad values are refused with a one-line error.
+#include "engine/simulation.hpp"
+#include "scenes/registry.hpp"
+#include "scenes/scene_file.hpp"
 #include "tests/tools/run_command.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -84,4 +88,52 @@ TEST_CASE("magsim-scene refuses bad ODE flags with a message and exit code 1", "
     CHECK(r.code == 1);
     CHECK(r.out.find(c.says) != std::string::npos);
   }
+}
+
+TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, reproduce the run's state hash", "[tools]") {
+  // a run whose options differ from the scene's in many places
+  const std::string out = tmp_dir("replay");
+  const Result r = run_scene("balls_up --count 27 --steps 50 --no-render --space hash --dt-m 8e-8 --tol 3e-5 "
+                             "--quickstep-iterations 40 --quickstep-w 1.2 --rolling-friction 1e-4 --max-substeps 2 "
+                             "--method anderson --threads 1 --out " + out);
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::ifstream f(out + "/summary.json");
+  const auto summary = nlohmann::json::parse(f);
+  CHECK(summary["options"]["magnetics"]["dt"] == 8e-8);
+  CHECK(summary["options"]["method"] == "anderson");
+  // the registry scene's bodies with the summary's options, read as a scene file
+  magsim::scenes::SceneParams p;
+  p.count = 27;
+  nlohmann::json scene = magsim::scenes::scene_to_json(magsim::scenes::find_scene("balls_up")->build(p));
+  scene["options"] = summary["options"];
+  magsim::engine::Simulation sim(magsim::scenes::parse_scene_json(scene.dump(), "replay.json"));
+  sim.run(50);
+  char hash[19];
+  std::snprintf(hash, sizeof hash, "%016" PRIx64, sim.state_hash());
+  CHECK(std::string(hash) == summary["state_hash"].get<std::string>());
+  // and not by accident: the scene's own options give another hash
+  magsim::engine::Simulation plain(magsim::scenes::find_scene("balls_up")->build(p));
+  plain.run(50);
+  CHECK(plain.state_hash() != sim.state_hash());
+}
+
+TEST_CASE("magsim-scene NAME --write-scene FILE: the file runs to the registry run's state hash", "[tools]") {
+  const std::string dir = tmp_dir("write_scene");
+  const std::string file = dir + "_balls_up.json";
+  const Result w = run_scene("balls_up --write-scene " + file);
+  INFO(w.out);
+  REQUIRE(w.code == 0);
+  const Result a = run_scene("balls_up --steps 50 --no-render --out " + dir + "/registry");
+  const Result b = run_scene(file + " --steps 50 --no-render --out " + dir + "/file");
+  INFO(a.out << b.out);
+  REQUIRE(a.code == 0);
+  REQUIRE(b.code == 0);
+  std::ifstream fa(dir + "/registry/summary.json"), fb(dir + "/file/summary.json");
+  const auto ja = nlohmann::json::parse(fa), jb = nlohmann::json::parse(fb);
+  CHECK(jb["bodies"] == 244);
+  CHECK(jb["source"] == file);
+  CHECK(ja["state_hash"] == jb["state_hash"]);
+  CHECK(ja["options"] == jb["options"]);
+  std::remove(file.c_str());
 }

@@ -1,0 +1,206 @@
+// scenes/options_json.cpp — SimOptions <-> JSON (scenes/options_json.hpp). The reader checks
+// each value's kind and range and names the JSON path of the first bad one; the writer
+// writes every field, so the two are each other's inverse (tests/engine/options_json_test.cpp).
+#include "scenes/options_json.hpp"
+
+#include "magnetics/magnetization.hpp"
+
+namespace magsim::scenes {
+
+using engine::SimOptions;
+using engine::SpaceKind;
+using json = nlohmann::json;
+
+const std::vector<std::string>& method_names() {
+  // mag::Method numbers its enumerators from 0 and method_name answers "?" past the last:
+  // the list follows magnetics/moments.cpp's table without a copy of it
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> v;
+    for (int i = 0; i < 256; ++i) {
+      const std::string n = mag::method_name(static_cast<mag::Method>(i));
+      if (n == "?") break;
+      v.push_back(n);
+    }
+    return v;
+  }();
+  return names;
+}
+
+std::string method_list(const char* sep) {
+  std::string s;
+  for (const std::string& n : method_names()) s += (s.empty() ? "" : sep) + n;
+  return s;
+}
+
+namespace {
+
+SpaceKind space_kind(const JsonReader& r, const json& j, const std::string& path) {
+  const std::string s = r.string(j, path);
+  SpaceKind k;
+  if (engine::parse_space(s, &k)) return k;
+  r.fail(path, "unknown space '" + s + "' (hash, sap, simple)");
+}
+
+mag::Method method(const JsonReader& r, const json& j, const std::string& path) {
+  const std::string s = r.string(j, path);
+  mag::Method m;
+  if (!mag::parse_method(s, &m))
+    r.fail(path, "unknown method '" + s + "' (" + method_list() + ")");
+  return m;
+}
+
+}  // namespace
+
+json to_json(const mag::DynamicsOptions& d) {
+  return json{{"dt", d.dt},
+              {"beta", d.beta},
+              {"alpha", d.alpha},
+              {"gamma_c_max", d.gamma_c_max},
+              {"adaptive_gamma_bound", d.adaptive_gamma_bound},
+              {"adaptive_gamma_cap", d.adaptive_gamma_cap},
+              {"tol", d.tol},
+              {"criterion", d.criterion == mag::DynamicsOptions::Criterion::Residual ? "residual" : "change"},
+              {"max_iter", d.max_iter},
+              {"min_pair_angle", d.min_pair_angle},
+              {"theta_integrator", d.theta_integrator == mag::ThetaIntegrator::Exact ? "exact" : "euler"},
+              {"anderson_depth", d.anderson_depth},
+              {"anderson_damping", d.anderson_damping},
+              {"anderson_restart_growth", d.anderson_restart_growth},
+              {"softening", d.field.softening},
+              {"bounded_pairs", d.field.bounded_pairs}};
+}
+
+json to_json(const SimOptions& o) {
+  const mag::FieldOptions& f = o.magnetics.field;
+  return json{{"method", mag::method_name(o.method)},
+              {"dt", o.dt},
+              {"gravity", vec3_json(o.gravity)},
+              {"ground", o.ground},
+              {"friction", o.friction},
+              {"restitution", o.restitution},
+              {"erp", o.erp},
+              {"cfm", o.cfm},
+              {"quickstep_iterations", o.quickstep_iterations},
+              {"quickstep_w", o.quickstep_w},
+              {"max_contacts", o.max_contacts},
+              {"space", engine::space_name(o.space)},
+              {"auto_disable", o.auto_disable},
+              {"linear_damping", o.linear_damping},
+              {"angular_damping", o.angular_damping},
+              {"surface_layer", o.surface_layer},
+              {"max_correcting_velocity", o.max_correcting_velocity},
+              {"contact_margin", o.contact_margin},
+              {"threads", o.threads},
+              {"reaction_symmetric_forces", o.reaction_symmetric_forces},
+              {"force_model", engine::force_choice_name(o.force_model)},
+              {"max_substeps", o.max_substeps},
+              {"substep_reach", o.substep_reach},
+              {"rolling_friction", o.rolling_friction},
+              {"max_body_speed", o.max_body_speed},
+              {"field_solver", mag::field_solver_name(f.solver)},
+              {"bh_theta", f.bh_theta},
+              {"bh_threshold", f.auto_threshold},
+              {"bh_leaf_size", f.bh_leaf_size},
+              {"bh_group_size", f.bh_group_size},
+              {"bh_order", f.bh_order},
+              {"bh_near_float", f.bh_near_float},
+              {"bh_far_float", f.bh_far_float},
+              {"magnetics", to_json(o.magnetics)}};
+}
+
+void from_json(const JsonReader& r, const json& j, const std::string& path, mag::DynamicsOptions* d) {
+  r.keys(j, path, {"dt", "beta", "alpha", "gamma_c_max", "adaptive_gamma_bound", "adaptive_gamma_cap",
+                   "tol", "criterion", "max_iter", "min_pair_angle", "theta_integrator", "softening",
+                   "bounded_pairs", "anderson_depth", "anderson_damping", "anderson_restart_growth"});
+  if_present(j, "dt", path, [&](const json& v, const std::string& p) { d->dt = r.in_range(v, p, 1e-9, 1e-6); });
+  if_present(j, "beta", path, [&](const json& v, const std::string& p) { d->beta = r.positive(v, p); });
+  if_present(j, "alpha", path, [&](const json& v, const std::string& p) { d->alpha = r.in_range(v, p, 1e-12, 1.0); });
+  if_present(j, "gamma_c_max", path, [&](const json& v, const std::string& p) { d->gamma_c_max = r.in_range(v, p, 1.0 / 3.0, 1e12); });
+  if_present(j, "adaptive_gamma_bound", path, [&](const json& v, const std::string& p) { d->adaptive_gamma_bound = r.boolean(v, p); });
+  if_present(j, "adaptive_gamma_cap", path, [&](const json& v, const std::string& p) { d->adaptive_gamma_cap = r.positive(v, p); });
+  if_present(j, "tol", path, [&](const json& v, const std::string& p) { d->tol = r.in_range(v, p, 1e-300, 0.999999); });
+  if_present(j, "max_iter", path, [&](const json& v, const std::string& p) { d->max_iter = r.integer(v, p, 1, 100000000); });
+  if_present(j, "min_pair_angle", path, [&](const json& v, const std::string& p) { d->min_pair_angle = r.in_range(v, p, 1e-300, 0.0099999); });
+  if_present(j, "theta_integrator", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (s == "exact") d->theta_integrator = mag::ThetaIntegrator::Exact;
+    else if (s == "euler") d->theta_integrator = mag::ThetaIntegrator::Euler;
+    else r.fail(p, "unknown theta integrator '" + s + "' (exact, euler)");
+  });
+  if_present(j, "criterion", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (s == "residual") d->criterion = mag::DynamicsOptions::Criterion::Residual;
+    else if (s == "change") d->criterion = mag::DynamicsOptions::Criterion::Change;
+    else r.fail(p, "unknown criterion '" + s + "' (residual, change)");
+  });
+  if_present(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.non_negative(v, p); });
+  if_present(j, "bounded_pairs", path, [&](const json& v, const std::string& p) { d->field.bounded_pairs = r.boolean(v, p); });
+  if_present(j, "anderson_depth", path, [&](const json& v, const std::string& p) { d->anderson_depth = r.integer(v, p, 0, 50); });
+  if_present(j, "anderson_damping", path, [&](const json& v, const std::string& p) { d->anderson_damping = r.in_range(v, p, 1e-300, 1.0); });
+  if_present(j, "anderson_restart_growth", path, [&](const json& v, const std::string& p) { d->anderson_restart_growth = r.positive(v, p); });
+  const std::string e = mag::validate(*d);
+  if (!e.empty()) r.fail(path, e);
+}
+
+void from_json(const JsonReader& r, const json& j, const std::string& path, SimOptions* o) {
+  r.keys(j, path, {"method", "dt", "gravity", "ground", "friction", "restitution", "erp", "cfm",
+                   "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
+                   "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
+                   "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
+                   "magnetics", "force_model", "max_substeps", "substep_reach", "rolling_friction",
+                   "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
+                   "bh_near_float", "bh_far_float"});
+  if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
+  if_present(j, "dt", path, [&](const json& v, const std::string& p) {
+    o->dt = r.number(v, p);
+    if (!(o->dt > 0 && o->dt <= 0.1)) r.fail(p, "must be in (0, 0.1] s (got " + JsonReader::fmt(o->dt) + ")");
+  });
+  if_present(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.vec3(v, p); });
+  if_present(j, "ground", path, [&](const json& v, const std::string& p) { o->ground = r.boolean(v, p); });
+  if_present(j, "friction", path, [&](const json& v, const std::string& p) { o->friction = r.non_negative(v, p); });
+  if_present(j, "restitution", path, [&](const json& v, const std::string& p) { o->restitution = r.in_range(v, p, 0, 1); });
+  if_present(j, "erp", path, [&](const json& v, const std::string& p) { o->erp = r.in_range(v, p, 0, 1); });
+  if_present(j, "cfm", path, [&](const json& v, const std::string& p) { o->cfm = r.non_negative(v, p); });
+  if_present(j, "quickstep_iterations", path, [&](const json& v, const std::string& p) { o->quickstep_iterations = r.integer(v, p, 1, 100000); });
+  if_present(j, "max_contacts", path, [&](const json& v, const std::string& p) { o->max_contacts = r.integer(v, p, 1, 64); });
+  if_present(j, "space", path, [&](const json& v, const std::string& p) { o->space = space_kind(r, v, p); });
+  if_present(j, "auto_disable", path, [&](const json& v, const std::string& p) { o->auto_disable = r.boolean(v, p); });
+  if_present(j, "linear_damping", path, [&](const json& v, const std::string& p) { o->linear_damping = r.non_negative(v, p); });
+  if_present(j, "angular_damping", path, [&](const json& v, const std::string& p) { o->angular_damping = r.non_negative(v, p); });
+  if_present(j, "surface_layer", path, [&](const json& v, const std::string& p) { o->surface_layer = r.non_negative(v, p); });
+  if_present(j, "max_correcting_velocity", path, [&](const json& v, const std::string& p) { o->max_correcting_velocity = r.non_negative(v, p); });
+  if_present(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
+  if_present(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = r.integer(v, p, 0, 1024); });
+  if_present(j, "force_model", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic)");
+  });
+  if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = r.integer(v, p, 1, 64); });
+  if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.positive(v, p); });
+  if_present(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.non_negative(v, p); });
+  if_present(j, "quickstep_w", path, [&](const json& v, const std::string& p) {
+    o->quickstep_w = r.number(v, p);
+    if (!(o->quickstep_w > 0 && o->quickstep_w < 2)) r.fail(p, "must be in (0, 2) (got " + JsonReader::fmt(o->quickstep_w) + ")");
+  });
+  if_present(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
+  mag::FieldOptions& f = o->magnetics.field;
+  if_present(j, "field_solver", path, [&](const json& v, const std::string& p) {
+    const std::string s = r.string(v, p);
+    if (!mag::parse_field_solver(s, &f.solver)) r.fail(p, "unknown field solver '" + s + "' (direct, barnes-hut, auto)");
+  });
+  if_present(j, "bh_theta", path, [&](const json& v, const std::string& p) {
+    f.bh_theta = r.number(v, p);
+    if (!(f.bh_theta > 0 && f.bh_theta <= 1)) r.fail(p, "must be in (0, 1] (got " + JsonReader::fmt(f.bh_theta) + ")");
+  });
+  if_present(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = r.integer(v, p, 0, 1000000000); });
+  if_present(j, "bh_leaf_size", path, [&](const json& v, const std::string& p) { f.bh_leaf_size = r.integer(v, p, 1, 1000000); });
+  if_present(j, "bh_group_size", path, [&](const json& v, const std::string& p) { f.bh_group_size = r.integer(v, p, 1, 1000000); });
+  if_present(j, "bh_order", path, [&](const json& v, const std::string& p) { f.bh_order = r.integer(v, p, 1, 2); });
+  if_present(j, "bh_near_float", path, [&](const json& v, const std::string& p) { f.bh_near_float = r.boolean(v, p); });
+  if_present(j, "bh_far_float", path, [&](const json& v, const std::string& p) { f.bh_far_float = r.boolean(v, p); });
+  if_present(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
+  if_present(j, "magnetics", path, [&](const json& v, const std::string& p) { from_json(r, v, p, &o->magnetics); });
+  o->magnetics.method = o->method;
+}
+
+}  // namespace magsim::scenes

@@ -1,0 +1,86 @@
+// tools/magsim_scene/magsim_scene.hpp — what the files of magsim-scene share: the
+// command-line arguments, the errors that pick the exit code, and the entry points
+// (main.cpp: flags and the scene they name; run.cpp: the run and --write-scene;
+// outputs.hpp/.cpp: summary.json's parts, states.csv, moments.csv, frames).
+#pragma once
+
+#include "engine/scene_desc.hpp"
+#include "tools/cli_common.hpp"
+#include "tools/field_flags.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace magsim::scene_tool {
+
+namespace engine = magsim::engine;
+namespace mag = magsim::mag;
+using tools::errno_text;
+using tools::Exit;
+using tools::kBadInput;
+using tools::kIoError;
+using tools::kOk;
+using tools::kRunFailed;
+
+// Runs above this many rigid steps are refused up front: the per-step timings alone take
+// 56 bytes a step (560 MB here), and at ~1 ms a step it is hours of wall time; a typo such
+// as --seconds 1e8 or "dt": 1e-12 would otherwise end in bad_alloc.
+constexpr double kMaxSteps = 1e7;
+
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// an output file could not be written (exit 3)
+struct IoError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+
+struct Args {
+  std::string scene;
+  std::string method;
+  double seconds = 0.0;
+  long steps = 0;
+  std::string out;
+  double fps = 60.0;
+  bool no_render = false;
+  bool arrows = false;
+  int width = 1280, height = 720, samples = 1;
+  int threads = 0;
+  int count = 0;
+  double strength = 0.0;
+  double dt_m = 0.0;
+  double tol = 0.0;
+  int max_iter = 0;
+  int quickstep_iterations = 0;
+  std::string space;
+  bool auto_disable = false;
+  std::string force_model;
+  int max_substeps = 0;
+  double substep_reach = 0.0;
+  double rolling_friction = 0.0;
+  double quickstep_w = 0.0;
+  double dt = 0.0;
+  std::string bounded_pairs;
+  tools::FieldFlags field;
+  bool list = false;
+  std::string write_scene;
+};
+
+
+std::string fmt(double x);
+bool ends_with(const std::string& s, const std::string& tail);
+/// "balls_up, alphabets, …"
+std::string registry_names();
+/// The scene named on the command line, with the command line's overrides applied
+/// (main.cpp); throws UsageError.
+engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app);
+/// The run: summary.json, states.csv, moments.csv and frames into --out (run.cpp).
+int run(const Args& a, const CLI::App& app);
+/// --write-scene FILE (run.cpp).
+int write_scene(const Args& a, const CLI::App& app);
+
+}  // namespace magsim::scene_tool

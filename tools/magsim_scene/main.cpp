@@ -1,0 +1,228 @@
+// tools/magsim_scene/main.cpp — magsim-scene's command line: the flags, the scene they
+// name with their overrides applied (resolve_scene), --list, and the exit codes.
+#include "scenes/options_json.hpp"
+#include "scenes/registry.hpp"
+#include "scenes/scene_file.hpp"
+#include "tools/magsim_scene/magsim_scene.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+namespace magsim::scene_tool {
+
+namespace scenes = magsim::scenes;
+
+std::string fmt(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+
+std::string registry_names() {
+  std::string names;
+  for (const scenes::SceneEntry& e : scenes::registry()) names += (names.empty() ? "" : ", ") + std::string(e.name);
+  return names;
+}
+
+
+namespace {
+
+// --threads above 4x the cores only slows the run down, and 1e5 makes libgomp crash
+int max_threads() {
+  const unsigned cores = std::thread::hardware_concurrency();
+  return 4 * static_cast<int>(cores > 0 ? cores : 1);
+}
+
+}  // namespace
+
+// The scene named on the command line, with the command line's overrides applied.
+engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
+  engine::SceneDesc s;
+  if (ends_with(a.scene, ".json")) {
+    if (app.count("--count")) throw UsageError("--count applies to registry scenes only, not to " + a.scene);
+    try {
+      s = scenes::load_scene_file(a.scene);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(e.what());
+    }
+    if (app.count("--strength"))
+      for (engine::BodyDesc& b : s.bodies)
+        for (engine::MomentDesc& m : b.moments)
+          if (m.permanent) m.moment *= a.strength;
+  } else {
+    const scenes::SceneEntry* e = scenes::find_scene(a.scene);
+    if (!e) throw UsageError("unknown scene '" + a.scene + "'; known: " + registry_names() + " (or a FILE.json)");
+    scenes::SceneParams p;
+    if (app.count("--count")) p.count = a.count;
+    if (app.count("--strength")) p.strength = a.strength;
+    s = e->build(p);
+  }
+  if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
+    throw UsageError("unknown method '" + a.method + "'");
+  if (app.count("--threads")) {
+    if (a.threads > max_threads())
+      throw UsageError("--threads: at most " + std::to_string(max_threads()) + " (4 x the " +
+                       std::to_string(max_threads() / 4) + " cores), got " + std::to_string(a.threads));
+    s.options.threads = a.threads;
+  }
+  if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
+  if (app.count("--tol")) s.options.magnetics.tol = a.tol;
+  if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
+  if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
+  if (app.count("--auto-disable")) s.options.auto_disable = true;
+  if (app.count("--force-model") && !engine::parse_force_choice(a.force_model, &s.options.force_model))
+    throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman or classic)");
+  if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
+  if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
+  if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
+  if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
+  if (app.count("--dt")) s.options.dt = a.dt;
+  if (app.count("--bounded-pairs")) {
+    if (a.bounded_pairs != "on" && a.bounded_pairs != "off")
+      throw UsageError("--bounded-pairs: expected on or off, got '" + a.bounded_pairs + "'");
+    s.options.magnetics.field.bounded_pairs = a.bounded_pairs == "on";
+  }
+  if (app.count("--space")) {
+    if (!engine::parse_space(a.space, &s.options.space))
+      throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
+  }
+  mag::FieldOptions& f = s.options.magnetics.field;
+  try {
+    a.field.apply(&f);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  if (const std::string e = mag::validate(f); !e.empty()) throw UsageError("field options: " + e);
+  s.options.magnetics.method = s.options.method;
+  return s;
+}
+
+
+namespace {
+
+// --seconds / --fps: CLI::PositiveNumber lets nan and inf through
+const auto kFinitePositive = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        const double x = std::stod(v);
+        if (std::isfinite(x) && x > 0) return {};
+      } catch (const std::exception&) {
+      }
+      return "must be a finite number > 0, got " + v;
+    },
+    "POSITIVE");
+
+// --width / --height: H.264 (tools/make_video.sh) needs even frame sizes
+const auto kEven = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        if (std::stol(v) % 2 == 0) return {};
+      } catch (const std::exception&) {
+        return {};  // the Range check names it
+      }
+      return "must be even (H.264), got " + v;
+    },
+    "EVEN");
+
+}  // namespace
+
+}  // namespace magsim::scene_tool
+
+using namespace magsim::scene_tool;
+
+int main(int argc, char** argv) {
+  CLI::App app{"magsim-scene: run one scene with one method and write summary.json, states.csv and "
+               "moments.csv"};
+  Args a;
+  app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
+  app.add_option("--method", a.method, scenes::method_list(" | ") + " (default: the scene's, ours-realigned)")
+      ->check(CLI::IsMember(scenes::method_names()));
+  auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
+                      ->check(kFinitePositive);
+  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, static_cast<long>(kMaxSteps)));
+  seconds->excludes(steps);
+  steps->excludes(seconds);
+  app.add_option("--out", a.out, "output directory (default: out/<scene>_<method>)");
+  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60), in [0.001, 1e9]")
+      ->check(kFinitePositive & CLI::Range(1e-3, 1e9));
+  app.add_flag("--no-render", a.no_render, "do not render frames");
+  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(CLI::Range(1, 4))->capture_default_str();
+  app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
+  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores")->check(CLI::Range(1, 1000000000));
+  app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(CLI::Range(1, 1000000000));
+  app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(CLI::PositiveNumber);
+  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
+  app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(CLI::PositiveNumber);
+  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(CLI::Range(1, 1000000000));
+  app.add_option("--quickstep-iterations", a.quickstep_iterations,
+                 "ODE QuickStep (contact solver) iterations per rigid step (default: the scene's, 20)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
+  app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
+  app.add_option("--force-model", a.force_model,
+                 "force on induced moments: method (the method's own: classic for kim2018, eq. 4 "
+                 "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) (default: the scene's, method)");
+  app.add_option("--max-substeps", a.max_substeps,
+                 "most rigid sub-steps per frame; a frame is split when bodies move fast (1 = never; default: the scene's)")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--substep-reach", a.substep_reach,
+                 "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rolling-friction", a.rolling_friction,
+                 "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
+      ->check(CLI::Range(1e-6, 1.999999));
+  app.add_option("--dt", a.dt, "rigid (frame) step dt_r in seconds, (0, 0.1] (default: the scene's, 1e-3)")
+      ->check(CLI::Range(1e-7, 0.1));
+  app.add_option("--bounded-pairs", a.bounded_pairs,
+                 "on | off: evaluate a pair of moments no closer than the sum of their interaction radii (default: the scene's, off)");
+  a.field.add(&app,
+              "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
+              "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
+              "--bh-threshold moments on");
+  app.add_flag("--list", a.list, "list the registry's scenes and exit");
+  app.add_option("--write-scene", a.write_scene,
+                 "write the scene (with --count, --strength and the option flags applied) as a scene "
+                 "FILE.json to edit and run, and exit without running");
+
+  app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
+                                      "an output file could not be written",
+                                      "Runs longer than 1e7 rigid steps are refused."));
+  if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
+  if (a.list) {
+    for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      std::fprintf(stderr, "error: writing the list to stdout failed (%s)\n", errno_text().c_str());
+      return kIoError;
+    }
+    return kOk;
+  }
+  if (a.scene.empty()) {
+    std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
+    return kBadInput;
+  }
+  try {
+    if (!a.write_scene.empty()) return write_scene(a, app);
+    return run(a, app);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kBadInput;
+  } catch (const IoError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kIoError;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kRunFailed;
+  }
+}
+

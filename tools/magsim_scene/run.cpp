@@ -1,0 +1,278 @@
+// tools/magsim_scene/run.cpp — runs one scene (from the registry or a JSON file) with one
+// method and writes what happened: summary.json (options, timings T_i/T_f/T_r, iteration
+// statistics, final metrics — attached, held, escaped beyond escape_radius, … —, the
+// energy audit, per-frame series, state hash, error), states.csv (body poses per frame) and
+// moments.csv (magnetizations per frame).
+//
+//   magsim-scene balls_up --method kim2018 --seconds 2
+//   magsim-scene scenes/examples/two_balls.json --steps 500 --out out/two
+//
+// Exit codes (the same in magsolve): 0 done, 1 bad usage, flags or scene, 2 the simulation
+// failed (SimulationError; summary.json holds the error and the last good state), 3 I/O
+// error (an output file could not be written).
+#include "scenes/options_json.hpp"
+#include "scenes/scene_file.hpp"
+#include "tools/magsim_scene/outputs.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace magsim::scene_tool {
+
+namespace scenes = magsim::scenes;
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t h = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + h, v.end());
+  const double hi = v[h];
+  if (v.size() % 2) return hi;
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + h));
+}
+
+double sum(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return s;
+}
+
+}  // namespace
+
+int run(const Args& a, const CLI::App& app) {
+  engine::SceneDesc scene = resolve_scene(a, app);
+  const std::string method = mag::method_name(scene.options.method);
+  std::unique_ptr<engine::Simulation> sim_ptr;
+  try {
+    sim_ptr = std::make_unique<engine::Simulation>(scene);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("scene '") + scene.name + "': " + e.what());
+  }
+  engine::Simulation& sim = *sim_ptr;
+  const engine::Model& model = sim.model();
+  const double dt = model.options.dt;
+
+  // the run's length, checked in double before any conversion to long
+  long n_steps = a.steps;
+  if (!app.count("--steps")) {
+    const bool flag = app.count("--seconds") > 0;
+    const double seconds = flag ? a.seconds : scene.default_seconds;
+    const std::string what = flag ? "--seconds " + fmt(seconds) : "the scene's default_seconds " + fmt(seconds);
+    if (seconds < dt * (1 - 1e-9))
+      throw UsageError(what + " is shorter than one rigid step (dt = " + fmt(dt) + " s)");
+    const double want = seconds / dt;
+    if (want > kMaxSteps)
+      throw UsageError(what + " at dt = " + fmt(dt) + " s is " + fmt(want) + " steps, more than the bound of " +
+                       fmt(kMaxSteps) + " steps");
+    n_steps = std::max(1L, std::lround(want));
+  }
+  if (static_cast<double>(n_steps) > kMaxSteps)
+    throw UsageError("--steps " + std::to_string(n_steps) + ": more than the bound of " + fmt(kMaxSteps) + " steps");
+  // a frame every per_frame steps; below one frame per run only the first and last are kept
+  const double frame_steps = 1.0 / (a.fps * dt);
+  const long per_frame = frame_steps >= static_cast<double>(n_steps) ? n_steps : std::max(1L, std::lround(frame_steps));
+  const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
+  // summary.json must not overwrite the scene file it was made from (--out = its folder)
+  if (ends_with(a.scene, ".json"))
+    for (const char* n : kOutputNames) {
+      std::error_code ec;
+      if (fs::equivalent(fs::path(dir) / n, a.scene, ec))
+        throw UsageError("--out " + dir + ": the output " + n + " would overwrite the input scene file " + a.scene);
+    }
+  prepare_out_dir(dir);
+  FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
+
+  Recorder rec(dir, sim);
+  std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters;
+  Ti.reserve(n_steps);
+  Tf.reserve(n_steps);
+  Tr.reserve(n_steps);
+  collide.reserve(n_steps);
+  quickstep.reserve(n_steps);
+  total.reserve(n_steps);
+  iters.reserve(n_steps);
+  long cap_hits = 0;
+  std::vector<double> substeps;  // rigid sub-steps per frame
+  substeps.reserve(n_steps);
+  std::string error;
+
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  auto last_report = t0;
+  std::string io_error;  // the first failed write; the run stops there
+  try {
+    if (rec.frame()) painter.draw(sim);
+    for (long k = 0; k < n_steps; ++k) {
+      try {
+        sim.step();
+      } catch (const engine::SimulationError& e) {
+        error = e.what();
+        break;
+      }
+      const engine::StepProfile& p = sim.last_profile();
+      Ti.push_back(p.T_i);
+      Tf.push_back(p.T_f);
+      Tr.push_back(p.T_r);
+      collide.push_back(p.collide_ms);
+      quickstep.push_back(p.quickstep_ms);
+      total.push_back(p.total_ms);
+      iters.push_back(p.iterations);
+      cap_hits += p.cap_hit ? 1 : 0;
+      substeps.push_back(p.substeps);
+      if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
+      const auto now = clock::now();
+      if (now - last_report >= std::chrono::seconds(2)) {
+        last_report = now;
+        std::fprintf(stderr,
+                     "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
+                     "iterations %d%s\n",
+                     scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
+                     std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
+                     p.cap_hit ? " (cap)" : "");
+      }
+    }
+    if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
+  } catch (const IoError& e) {
+    io_error = e.what();
+  }
+  try {
+    painter.finish();
+  } catch (const std::exception& e) {
+    if (io_error.empty()) io_error = std::string("writing frames: ") + e.what();
+  }
+  try {
+    rec.close();
+  } catch (const IoError& e) {
+    if (io_error.empty()) io_error = e.what();
+  }
+  const double wall = std::chrono::duration<double>(clock::now() - t0).count();
+
+  const engine::Metrics fin = sim.metrics();
+  char hash[19];
+  std::snprintf(hash, sizeof hash, "%016" PRIx64, sim.state_hash());
+  auto stats = [](const std::vector<double>& v) { return json{{"median", median(v)}, {"total", sum(v)}}; };
+  json summary{
+      {"scene", scene.name},
+      {"source", ends_with(a.scene, ".json") ? a.scene : "registry"},
+      {"description", scene.description},
+      {"modelling_level", scene.modelling_level},
+      {"method", method},
+      // the run's options in the scene file's spelling (scenes/options_json.hpp): pasted into
+      // a scene file as "options" they rerun this run
+      {"options", scenes::to_json(model.options)},
+      {"field_solver_used", mag::field_solver_name(mag::resolve_solver(model.options.magnetics.field,
+                                                                        static_cast<std::size_t>(model.nmoment)))},
+      {"contact_margin_used", model.contact_margin},
+      {"H0", scenes::vec3_json(model.H0)},
+      {"params", {{"count", a.count}, {"strength", app.count("--strength") ? a.strength : 1.0}}},
+      {"escape_radius", model.escape_radius},
+      {"bodies", model.nbody},
+      {"dynamic_bodies", model.dynamic_bodies.size()},
+      {"moments", model.nmoment},
+      {"induced_moments", model.induced_count},
+      {"steps", sim.steps()},
+      {"steps_requested", n_steps},
+      {"seconds", sim.time()},
+      {"fps", a.fps},
+      {"frames", rec.frames()},
+      {"rendered_frames", painter.frames()},
+      {"render_ms_median", median(painter.ms())},
+      {"wall_seconds", wall},
+      {"timing_ms",
+       {{"T_i", stats(Ti)},
+        {"T_f", stats(Tf)},
+        {"T_r", stats(Tr)},
+        {"collide", stats(collide)},
+        {"quickstep", stats(quickstep)},
+        {"step", stats(total)}}},
+      {"iterations",
+       {{"median", median(iters)},
+        {"max", iters.empty() ? 0.0 : *std::max_element(iters.begin(), iters.end())},
+        {"mean", iters.empty() ? 0.0 : sum(iters) / static_cast<double>(iters.size())},
+        {"cap_hits", cap_hits}}},
+      // rigid sub-steps per 1 frame step (SimOptions::max_substeps); T_i/T_f/T_r above are
+      // per frame, all of its sub-steps included
+      {"substeps",
+       {{"median", median(substeps)},
+        {"max", substeps.empty() ? 0.0 : *std::max_element(substeps.begin(), substeps.end())},
+        {"mean", substeps.empty() ? 0.0 : sum(substeps) / static_cast<double>(substeps.size())}}},
+      {"final",
+       {{"kinetic_energy", fin.kinetic_energy},
+        {"max_speed", fin.max_speed},
+        {"bounding_radius", fin.bounding_radius},
+        {"magnet_radius", fin.magnet_radius},
+        {"attached", fin.attached},
+        {"held", fin.held},
+        {"escaped", fin.escaped},
+        {"momentum", scenes::vec3_json(fin.momentum)},
+        {"contacts", fin.contacts}}},
+      {"energy", energy_json(sim)},
+      {"series", rec.series()},
+      {"state_hash", hash},
+      {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};
+
+  // written to a temporary name and renamed when complete: a full disk leaves no
+  // summary.json that looks valid
+  const fs::path path = fs::path(dir) / "summary.json";
+  const fs::path tmp = fs::path(dir) / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << summary.dump(1) << '\n';
+    out.close();
+    std::error_code ec;
+    if (!out || (fs::rename(tmp, path, ec), ec)) {
+      const std::string why = ec ? ec.message() : errno_text();
+      fs::remove(tmp, ec);
+      std::fprintf(stderr, "error: cannot write %s (%s)%s%s\n", path.c_str(), why.c_str(),
+                   io_error.empty() ? "" : "; before that: ", io_error.c_str());
+      return kIoError;
+    }
+  }
+  if (!io_error.empty()) {
+    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", io_error.c_str(), path.c_str());
+    return kIoError;
+  }
+  if (!error.empty()) {
+    std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
+    return kRunFailed;
+  }
+  const mag::FieldOptions& fo = model.options.magnetics.field;
+  std::fprintf(stderr,
+               "%s %s: %ld steps, t = %.4f s, wall %.2f s, median T_i %.3f T_f %.3f T_r %.3f step %.3f ms; "
+               "field solver %s (%s, %d moments); %s\n",
+               scene.name.c_str(), method.c_str(), sim.steps(), sim.time(), wall, median(Ti), median(Tf),
+               median(Tr), median(total), mag::field_solver_name(mag::resolve_solver(fo, static_cast<std::size_t>(model.nmoment))),
+               mag::field_solver_name(fo.solver), model.nmoment, path.c_str());
+  return kOk;
+}
+
+
+// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written to
+// FILE.tmp and renamed, so a failed write leaves no half file under the name.
+int write_scene(const Args& a, const CLI::App& app) {
+  const engine::SceneDesc scene = resolve_scene(a, app);
+  const fs::path path = a.write_scene;
+  const fs::path tmp = path.string() + ".tmp";
+  std::ofstream out(tmp);
+  out << scenes::scene_to_json(scene).dump(1) << '\n';
+  out.close();
+  std::error_code ec;
+  if (!out || (fs::rename(tmp, path, ec), ec)) {
+    const std::string why = ec ? ec.message() : errno_text();
+    fs::remove(tmp, ec);
+    throw IoError("--write-scene: cannot write " + path.string() + " (" + why + ")");
+  }
+  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), path.c_str());
+  return kOk;
+}
+
+}  // namespace magsim::scene_tool
