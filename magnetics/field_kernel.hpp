@@ -1,6 +1,6 @@
 // magnetics/field_kernel.hpp — internal: the packed-source layout and the SIMD pair kernel
 // behind compute_fields (dipole_field.cpp) and the near field of Barnes–Hut (barnes_hut.cpp),
-// and its single-precision variant for the Barnes–Hut near field (near_kernel_f32.cpp).
+// in double and in single precision (both in pair_kernel.cpp).
 // Not part of the public API: include only from magnetics/*.cpp (and the kernel's own
 // tests and benchmark).
 #pragma once

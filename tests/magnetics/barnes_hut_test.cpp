@@ -54,6 +54,7 @@ Errors bh_errors(const MomentSet& s, FieldOptions bh) {
 
 // The same evaluation with the AVX-512 kernels and with the portable loops.
 Errors simd_vs_portable(const MomentSet& s, const FieldOptions& o) {
+  MAGSIM_NOTE_IF_NO_SIMD();
   FieldWorkspace ws;
   std::vector<Vec3> H1, H2;
   std::vector<Mat3> J1, J2;

@@ -109,6 +109,7 @@ TEST_CASE("bounded pairs: the Jacobian is the derivative of the field beyond con
 }
 
 TEST_CASE("bounded pairs: every kernel agrees on an overlapping pile", "[field][bounded]") {
+  MAGSIM_NOTE_IF_NO_SIMD();
   // the dense pile squeezed by 10 %: every neighbour pair overlaps
   MomentSet s = magsim::test::fcc_pile(2500);
   for (Vec3& p : s.position) p *= 0.9;

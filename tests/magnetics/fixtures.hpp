@@ -1,6 +1,7 @@
 // tests/magnetics/fixtures.hpp — small magnetic configurations shared by the core tests.
 #pragma once
 
+#include "magnetics/field_kernel.hpp"
 #include "magnetics/moments.hpp"
 
 #include <cmath>
@@ -105,5 +106,15 @@ inline MomentSet fcc_pile(int n) {
   s.add_permanent(pm, 8e-6, mm);
   return s;
 }
+
+/// Says so in the test output when this CPU has no AVX-512 (or it is switched off): then a
+/// SIMD-vs-portable comparison runs the portable loops twice and proves nothing about the
+/// AVX-512 kernels. Call at the top of such a test.
+#define MAGSIM_NOTE_IF_NO_SIMD()                                                              \
+  do {                                                                                      \
+    if (!magsim::mag::detail::simd_kernel_active())                                         \
+      WARN("no AVX-512 here: the SIMD-vs-portable comparison compares the portable path "   \
+           "with itself");                                                                  \
+  } while (0)
 
 }  // namespace magsim::test
