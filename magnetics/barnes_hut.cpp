@@ -150,7 +150,8 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
       if (new_lists) build_lists(*ws, g, opt.bh_theta, min_gap, want_J, &th.stack, &lists[l]);
       th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
       gather(*ws, g, lists[l], near_float, far_float, &th);
-      const detail::SourceView vn = th.near.view(bounded), vj = th.near_j.view(bounded);
+      const detail::SourceView vn = detail::view_of(th.near, bounded, 0, th.near.size()),
+                               vj = detail::view_of(th.near_j, bounded, 0, th.near_j.size());
       const detail::SourceViewF vnf = th.nearf.view(bounded), vjf = th.nearf_j.view(bounded);
       const long nt = g.t1 - g.t0;
       th.near_pairs += nt * static_cast<long>(vn.n + vj.n + vnf.n + vjf.n);

@@ -135,38 +135,7 @@ struct CellBufferF {
 };
 
 // Near sources gathered for one group: whole leaves copied from the tree-ordered arrays.
-struct NearBuffer {
-  std::vector<double> a[9];  // x, y, z, mx, my, mz, id, grp, rad (grown, never shrunk)
-  std::size_t n = 0;
-  void clear() { n = 0; }
-  void reserve(std::size_t m) {
-    if (m > a[0].size())
-      for (auto& v : a) v.resize(std::max(m, 2 * a[0].size()));
-  }
-  void append(const detail::SourceBuffer& s, int s0, int s1) {
-    reserve(n + (s1 - s0) + detail::kSourcePad);
-    const std::vector<double>* src[9] = {&s.x,  &s.y,  &s.z,   &s.mx, &s.my,
-                                         &s.mz, &s.id, &s.grp, &s.rad};
-    for (int k = 0; k < 9; ++k) std::copy(src[k]->begin() + s0, src[k]->begin() + s1, a[k].begin() + n);
-    n += s1 - s0;
-  }
-  void pad() {
-    reserve(n + detail::kSourcePad);
-    while (n % detail::kSourcePad != 0) {
-      for (int k = 0; k < 3; ++k) a[k][n] = detail::kPadPosition;
-      for (int k = 3; k < 6; ++k) a[k][n] = 0.0;
-      a[6][n] = a[7][n] = -1.0;
-      a[8][n] = 0.0;
-      ++n;
-    }
-  }
-  // bounded: pass the radii (bounded pairs), else unbounded point dipoles
-  detail::SourceView view(bool bounded) const {
-    return detail::SourceView{a[0].data(), a[1].data(), a[2].data(), a[3].data(),
-                              a[4].data(), a[5].data(), a[6].data(), a[7].data(), n,
-                              bounded ? a[8].data() : nullptr};
-  }
-};
+using NearBuffer = detail::SourceBuffer;
 
 // The same, in float for sum_pairs_f32 (FieldOptions::bh_near_float): positions relative
 // to the group's centre (converted from the double difference; never absolute coordinates

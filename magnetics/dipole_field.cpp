@@ -92,8 +92,7 @@ FieldSolver resolve_solver(const FieldOptions& opt, std::size_t n) {
 
 // scratch: a copy starts with the packed arrays but builds its own tree
 FieldWorkspace::FieldWorkspace(const FieldWorkspace& o)
-    : sx(o.sx), sy(o.sy), sz(o.sz), smx(o.smx), smy(o.smy), smz(o.smz), sid(o.sid),
-      sgrp(o.sgrp), srad(o.srad), bounded(o.bounded) {}
+    : src(o.src), bounded(o.bounded) {}
 FieldWorkspace& FieldWorkspace::operator=(const FieldWorkspace& o) {
   if (this != &o) {
     FieldWorkspace t(o);
@@ -117,6 +116,17 @@ void SourceBuffer::push(double px, double py, double pz, double qx, double qy, d
   rad.push_back(radius);
 }
 
+void SourceBuffer::append(const SourceBuffer& s, std::size_t b, std::size_t e) {
+  std::vector<double>* to[9] = {&x, &y, &z, &mx, &my, &mz, &id, &grp, &rad};
+  const std::vector<double>* from[9] = {&s.x, &s.y, &s.z, &s.mx, &s.my, &s.mz, &s.id, &s.grp, &s.rad};
+  for (int k = 0; k < 9; ++k) to[k]->insert(to[k]->end(), from[k]->begin() + b, from[k]->begin() + e);
+}
+
+void SourceBuffer::pad() {
+  while (size() % kSourcePad != 0)
+    push(kPadPosition, kPadPosition, kPadPosition, 0.0, 0.0, 0.0, -1.0, -1.0, 0.0);
+}
+
 }  // namespace detail
 
 namespace {
@@ -128,30 +138,16 @@ constexpr std::size_t kChunk = 4096;
 constexpr long kTargetBlock = 32;
 
 void pack_sources(const MomentSet& set, const FieldOptions& opt, FieldWorkspace* ws) {
-  std::vector<double>* a[] = {&ws->sx, &ws->sy, &ws->sz, &ws->smx, &ws->smy, &ws->smz,
-                              &ws->sid, &ws->sgrp, &ws->srad};
-  for (auto* v : a) v->clear();
-  auto push = [&](const Vec3& p, const Vec3& m, double id, double grp, double rad) {
-    ws->sx.push_back(p.x()); ws->sy.push_back(p.y()); ws->sz.push_back(p.z());
-    ws->smx.push_back(m.x()); ws->smy.push_back(m.y()); ws->smz.push_back(m.z());
-    ws->sid.push_back(id); ws->sgrp.push_back(grp < 0 ? -1.0 : grp);
-    ws->srad.push_back(rad);
-  };
+  ws->src.clear();
   for (std::size_t i = 0; i < set.size(); ++i) {
     const Vec3 m = set.moment(i);
     if (m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0) continue;
-    push(set.position[i], m, static_cast<double>(i), set.group[i], set.radius[i]);
+    const Vec3& p = set.position[i];
+    ws->src.push(p.x(), p.y(), p.z(), m.x(), m.y(), m.z(), static_cast<double>(i), set.group[i],
+                 set.radius[i]);
   }
-  const Vec3 far = Vec3::Constant(detail::kPadPosition);
-  while (ws->sx.size() % detail::kSourcePad != 0) push(far, Vec3::Zero(), -1.0, -1.0, 0.0);
+  ws->src.pad();
   ws->bounded = pairs_bounded(set, opt);
-}
-
-detail::SourceView packed_view(const FieldWorkspace& ws, std::size_t b, std::size_t e) {
-  return detail::SourceView{ws.sx.data() + b,  ws.sy.data() + b,  ws.sz.data() + b,
-                            ws.smx.data() + b, ws.smy.data() + b, ws.smz.data() + b,
-                            ws.sid.data() + b, ws.sgrp.data() + b, e - b,
-                            ws.bounded ? ws.srad.data() + b : nullptr};
 }
 
 detail::Target target_of(const MomentSet& set, std::size_t j) {
@@ -165,7 +161,7 @@ detail::Target target_of(const MomentSet& set, std::size_t j) {
 void direct_sum(const MomentSet& set, const FieldOptions& opt, const FieldWorkspace& ws,
                 const int* idx, long nt, Vec3* H, Mat3* J) {
   const double eps2 = opt.softening * opt.softening;
-  const std::size_t ns = ws.sx.size();
+  const std::size_t ns = ws.src.size();
   const detail::PairTerms terms = J ? detail::PairTerms::HJ : detail::PairTerms::H;
   const long nblocks = (nt + kTargetBlock - 1) / kTargetBlock;
 #pragma omp parallel for schedule(static)
@@ -175,7 +171,7 @@ void direct_sum(const MomentSet& set, const FieldOptions& opt, const FieldWorksp
     detail::Target tg[kTargetBlock];
     for (long j = j0; j < j1; ++j) tg[j - j0] = target_of(set, idx ? idx[j] : j);
     for (std::size_t c = 0; c < ns; c += kChunk) {
-      const detail::SourceView v = packed_view(ws, c, std::min(ns, c + kChunk));
+      const detail::SourceView v = detail::view_of(ws.src, ws.bounded, c, std::min(ns, c + kChunk));
       for (long j = j0; j < j1; ++j)
         detail::sum_pairs(v, tg[j - j0], eps2, terms, acc[j - j0], acc[j - j0] + 3);
     }

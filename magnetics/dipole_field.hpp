@@ -74,6 +74,28 @@ struct BarnesHutWorkspaceDeleter {
   void operator()(BarnesHutWorkspace* p) const;  // defined in barnes_hut.cpp
 };
 
+namespace detail {
+/// Flat source arrays (structure of arrays) as the pair kernel reads them (field_kernel.hpp):
+/// the direct sum's packed sources, Barnes–Hut's tree-ordered ones and a target group's
+/// gathered near sources alike. clear() keeps the capacity.
+struct SourceBuffer {
+  std::vector<double> x, y, z;     ///< (ns) position (m)
+  std::vector<double> mx, my, mz;  ///< (ns) moment (A·m²)
+  std::vector<double> id;          ///< (ns) moment index (−1 for padding), for self-exclusion
+  std::vector<double> grp;         ///< (ns) group id (negative groups stored as −1)
+  std::vector<double> rad;         ///< (ns) interaction radius (m), 0 = a point
+
+  std::size_t size() const { return x.size(); }
+  void clear();
+  void push(double px, double py, double pz, double qx, double qy, double qz, double index,
+            double group, double radius = 0.0);
+  /// Appends sources [b, e) of s.
+  void append(const SourceBuffer& s, std::size_t b, std::size_t e);
+  /// Pads to a multiple of the kernel's block with zero moments far away (they add exactly 0).
+  void pad();
+};
+}  // namespace detail
+
 /// Packed copies of the sources (flat arrays for the kernel) — per-solve scratch.
 struct FieldWorkspace {
   FieldWorkspace() = default;
@@ -83,9 +105,8 @@ struct FieldWorkspace {
   FieldWorkspace(const FieldWorkspace& o);
   FieldWorkspace& operator=(const FieldWorkspace& o);
 
-  /// (ns, padded to a multiple of 8) source position (m), moment (A·m²), index, group,
-  /// interaction radius (m)
-  std::vector<double> sx, sy, sz, smx, smy, smz, sid, sgrp, srad;
+  /// the nonzero sources, padded (pack order: moment index)
+  detail::SourceBuffer src;
   bool bounded = false;  ///< the packed sources are summed as bounded pairs
   /// Barnes–Hut tree and per-thread scratch, created on first use.
   std::unique_ptr<BarnesHutWorkspace, BarnesHutWorkspaceDeleter> bh;

@@ -5,6 +5,7 @@
 // tests and benchmark).
 #pragma once
 
+#include "magnetics/dipole_field.hpp"
 #include "magnetics/types.hpp"
 
 #include <cstddef>
@@ -30,20 +31,6 @@ inline constexpr std::size_t kSourcePad = 8;
 /// moment makes every term exactly zero.
 inline constexpr double kPadPosition = 1e15;
 
-/// Flat source arrays (structure of arrays).
-struct SourceBuffer {
-  std::vector<double> x, y, z;     ///< (ns) position (m)
-  std::vector<double> mx, my, mz;  ///< (ns) moment (A·m²)
-  std::vector<double> id;          ///< (ns) moment index (−1 for padding), for self-exclusion
-  std::vector<double> grp;         ///< (ns) group id (negative groups stored as −1)
-  std::vector<double> rad;         ///< (ns) interaction radius (m), 0 = a point
-
-  std::size_t size() const { return x.size(); }
-  void clear();
-  void push(double px, double py, double pz, double qx, double qy, double qz, double index,
-            double group, double radius = 0.0);
-};
-
 /// A read-only view of padded source arrays (as FieldWorkspace's or a gathered copy).
 struct SourceView {
   const double *x, *y, *z, *mx, *my, *mz, *id, *grp;
@@ -51,6 +38,13 @@ struct SourceView {
   /// interaction radii a_i (m); nullptr = unbounded point dipoles (see sum_pairs)
   const double* rad;
 };
+
+/// The view of sources [b, e) of a padded buffer (bounded: with their radii).
+inline SourceView view_of(const SourceBuffer& s, bool bounded, std::size_t b, std::size_t e) {
+  return SourceView{s.x.data() + b,  s.y.data() + b,  s.z.data() + b,   s.mx.data() + b,
+                    s.my.data() + b, s.mz.data() + b, s.id.data() + b,  s.grp.data() + b,
+                    e - b,           bounded ? s.rad.data() + b : nullptr};
+}
 
 /// A target point: its own moment index (−1: none) and group for the exclusions.
 struct Target {
