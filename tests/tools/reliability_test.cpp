@@ -216,3 +216,46 @@ TEST_CASE("magsim-scene: a directory named like a scene file is a one-line error
   CHECK(r.code == 1);
   CHECK(r.out.find("is a directory") != std::string::npos);
 }
+
+TEST_CASE("magsolve: two moments closer than half their radii are refused without --softening", "[reliability]") {
+  // 1e-12 m apart: F = 4e41 N before (only exact coincidence was refused)
+  const CommandResult r = solve(input("close_pair_magsolve.json"));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("moments[1] and moments[2] are 1e-12 m apart, closer than 0.005 m") != std::string::npos);
+  CHECK(r.out.find("--softening") != std::string::npos);
+  CHECK(lines(r.out) == 1);
+  // with softening the case is solved
+  const CommandResult soft = solve(input("close_pair_magsolve.json") + " --softening 0.001");
+  INFO(soft.out);
+  CHECK(soft.code == 0);
+  // touching spheres (2 radii apart) stay allowed
+  CHECK(solve(example("touching_spheres.json")).code == 0);
+}
+
+TEST_CASE("magsolve: a non-finite torque is exit 2 naming it, never printed as null", "[reliability]") {
+  const CommandResult r = solve(input("infinite_torque_magsolve.json"));
+  INFO(r.out);
+  CHECK(r.code == 2);
+  CHECK(r.out.find("the torque of moments[0] is not finite") != std::string::npos);
+  CHECK(r.out.find("null") == std::string::npos);
+}
+
+TEST_CASE("magsolve: converged means M = f(H), not only a small change per iteration", "[reliability]") {
+  // a 1 A/m field: the dynamics change M by less than tol x Ms per iteration from the start
+  // and stop after 4 iterations at |M| = 2.16 A/m, 30 % short of f(H) = 3.1 A/m
+  const CommandResult r = solve(input("weak_field_magsolve.json") + " --method ours");
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("\"converged\": false") != std::string::npos);
+  CHECK(r.out.find("\"criterion_met\": true") != std::string::npos);
+  // Anderson solves M = f(H) itself: converged
+  const CommandResult a = solve(input("weak_field_magsolve.json") + " --method anderson");
+  INFO(a.out);
+  CHECK(a.code == 0);
+  CHECK(a.out.find("\"converged\": true") != std::string::npos);
+  // the CSV header line says the same
+  const CommandResult c = solve(input("weak_field_magsolve.json") + " --method ours --format csv");
+  CHECK(c.out.find("converged=false criterion_met=true") != std::string::npos);
+  CHECK(c.out.find("relative residual") != std::string::npos);  // the note on stderr
+}
