@@ -50,6 +50,8 @@
 //   "scene.json: bodies[3].shapes[0].size: must be 3 positive numbers (half extents)".
 #include "scenes/scene_file.hpp"
 
+#include "engine/limits.hpp"
+#include "engine/model.hpp"
 #include "magnetics/magnetization.hpp"
 #include "scenes/json_unique_keys.hpp"
 
@@ -137,6 +139,17 @@ class Reader {
     if (x < lo || x > hi)
       fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(x) + ")");
     return static_cast<int>(x);
+  }
+  // engine/limits.hpp: finite magnitudes beyond what ODE (or the magnetics) can take
+  void at_most(const std::string& path, double magnitude, double max, const char* unit) const {
+    if (magnitude > max)
+      fail(path, "magnitude " + fmt(magnitude) + " " + unit + " exceeds " + fmt(max) + " " + unit +
+                     " (engine/limits.hpp: beyond it the rigid-body or magnetics arithmetic overflows)");
+  }
+  Vec3 bounded(const json& j, const std::string& path, double max, const char* unit) const {
+    const Vec3 v = vec3(j, path);
+    at_most(path, v.stableNorm(), max, unit);
+    return v;
   }
   bool boolean(const json& j, const std::string& path) const {
     if (!j.is_boolean()) fail(path, "must be true or false");
@@ -262,27 +275,30 @@ ShapeDesc read_shape(const Reader& r, const json& j, const std::string& path) {
   r.keys(j, path, {"kind", "offset", "rotation", "size"});
   ShapeDesc s;
   opt(j, "kind", path, [&](const json& v, const std::string& p) { s.kind = shape_kind(r, v, p); });
-  opt(j, "offset", path, [&](const json& v, const std::string& p) { s.offset = r.vec3(v, p); });
+  opt(j, "offset", path, [&](const json& v, const std::string& p) { s.offset = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   opt(j, "rotation", path, [&](const json& v, const std::string& p) { s.rotation = r.quat(v, p); });
   if (!j.contains("size")) r.fail(Reader::join(path, "size"), "required");
   s.size = shape_size(r, s.kind, j.at("size"), Reader::join(path, "size"));
+  r.at_most(Reader::join(path, "size"), s.size.cwiseAbs().maxCoeff(), engine::limits::kMaxSize, "m");
   return s;
 }
 
 MomentDesc read_moment(const Reader& r, const json& j, const std::string& path) {
   r.keys(j, path, {"offset", "permanent", "volume", "Ms", "moment", "interaction_radius"});
   MomentDesc m;
-  opt(j, "offset", path, [&](const json& v, const std::string& p) { m.offset = r.vec3(v, p); });
+  opt(j, "offset", path, [&](const json& v, const std::string& p) { m.offset = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   opt(j, "permanent", path, [&](const json& v, const std::string& p) { m.permanent = r.boolean(v, p); });
   if (!j.contains("volume")) r.fail(Reader::join(path, "volume"), "required (> 0, m³)");
   m.volume = r.positive(j.at("volume"), Reader::join(path, "volume"));
+  r.at_most(Reader::join(path, "volume"), m.volume, engine::limits::kMaxVolume, "m^3");
   opt(j, "Ms", path, [&](const json& v, const std::string& p) {
     if (m.permanent) r.fail(p, "only for induced moments (\"permanent\": false)");
     m.Ms = r.positive(v, p);
+    r.at_most(p, m.Ms, engine::limits::kMaxMs, "A/m");
   });
   opt(j, "moment", path, [&](const json& v, const std::string& p) {
     if (!m.permanent) r.fail(p, "only for permanent moments (\"permanent\": true)");
-    m.moment = r.vec3(v, p);
+    m.moment = r.bounded(v, p, engine::limits::kMaxMoment, "A·m^2");
   });
   opt(j, "interaction_radius", path, [&](const json& v, const std::string& p) { m.interaction_radius = r.number(v, p); });
   // a permanent moment without "moment" used to load as a zero magnet
@@ -298,12 +314,20 @@ BodyDesc read_body(const Reader& r, const json& j, const std::string& path, std:
   b.name = "body_" + std::to_string(i);
   opt(j, "name", path, [&](const json& v, const std::string& p) { b.name = r.string(v, p); });
   opt(j, "type", path, [&](const json& v, const std::string& p) { b.type = body_type(r, v, p); });
-  opt(j, "position", path, [&](const json& v, const std::string& p) { b.position = r.vec3(v, p); });
+  opt(j, "position", path, [&](const json& v, const std::string& p) { b.position = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   opt(j, "orientation", path, [&](const json& v, const std::string& p) { b.orientation = r.quat(v, p); });
-  opt(j, "velocity", path, [&](const json& v, const std::string& p) { b.velocity = r.vec3(v, p); });
-  opt(j, "angular_velocity", path, [&](const json& v, const std::string& p) { b.angular_velocity = r.vec3(v, p); });
+  opt(j, "velocity", path, [&](const json& v, const std::string& p) { b.velocity = r.bounded(v, p, engine::limits::kMaxSpeed, "m/s"); });
+  opt(j, "angular_velocity", path, [&](const json& v, const std::string& p) {
+    b.angular_velocity = r.bounded(v, p, engine::limits::kMaxAngularSpeed, "rad/s");
+  });
   opt(j, "density", path, [&](const json& v, const std::string& p) { b.density = r.positive(v, p); });
-  opt(j, "mass", path, [&](const json& v, const std::string& p) { b.mass = r.non_negative(v, p); });
+  opt(j, "mass", path, [&](const json& v, const std::string& p) {
+    b.mass = r.non_negative(v, p);
+    if (b.mass > 0 && (b.mass < engine::limits::kMinMass || b.mass > engine::limits::kMaxMass))
+      r.fail(p, "must be 0 (density x volume) or in [" + Reader::fmt(engine::limits::kMinMass) + ", " +
+                    Reader::fmt(engine::limits::kMaxMass) + "] kg (got " + Reader::fmt(b.mass) +
+                    "; engine/limits.hpp: beyond it ODE's arithmetic overflows)");
+  });
   opt(j, "color", path, [&](const json& v, const std::string& p) { b.color = r.color(v, p); });
   opt(j, "visible", path, [&](const json& v, const std::string& p) { b.visible = r.boolean(v, p); });
   opt(j, "magnet", path, [&](const json& v, const std::string& p) { b.magnet = r.boolean(v, p); });
@@ -363,7 +387,7 @@ void read_options(const Reader& r, const json& j, const std::string& path, SimOp
     o->dt = r.number(v, p);
     if (!(o->dt > 0 && o->dt <= 0.1)) r.fail(p, "must be in (0, 0.1] s (got " + Reader::fmt(o->dt) + ")");
   });
-  opt(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.vec3(v, p); });
+  opt(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.bounded(v, p, engine::limits::kMaxGravity, "m/s^2"); });
   opt(j, "ground", path, [&](const json& v, const std::string& p) { o->ground = r.boolean(v, p); });
   opt(j, "friction", path, [&](const json& v, const std::string& p) { o->friction = r.non_negative(v, p); });
   opt(j, "restitution", path, [&](const json& v, const std::string& p) { o->restitution = r.in_range(v, p, 0, 1); });
@@ -416,6 +440,8 @@ void read_camera(const Reader& r, const json& j, const std::string& path, render
   });
   opt(j, "z_near", path, [&](const json& v, const std::string& p) { c->z_near = static_cast<float>(r.non_negative(v, p)); });
   opt(j, "z_far", path, [&](const json& v, const std::string& p) { c->z_far = static_cast<float>(r.non_negative(v, p)); });
+  // a degenerate view rendered blank (eye = target) or a guessed orientation (up ∥ view)
+  if (const std::string e = engine::camera_error(*c); !e.empty()) r.fail(path, e);
 }
 
 // The scene name becomes the output folder out/<name>_<method>: no path separators, no "."
@@ -473,7 +499,7 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   opt(doc, "modelling_level", "", [&](const json& v, const std::string& p) { s.modelling_level = r.string(v, p); });
   opt(doc, "default_seconds", "", [&](const json& v, const std::string& p) { s.default_seconds = r.positive(v, p); });
   opt(doc, "escape_radius", "", [&](const json& v, const std::string& p) { s.escape_radius = r.non_negative(v, p); });
-  opt(doc, "H0", "", [&](const json& v, const std::string& p) { s.H0 = r.vec3(v, p); });
+  opt(doc, "H0", "", [&](const json& v, const std::string& p) { s.H0 = r.bounded(v, p, engine::limits::kMaxField, "A/m"); });
   opt(doc, "camera", "", [&](const json& v, const std::string& p) { read_camera(r, v, p, &s.camera); });
   opt(doc, "options", "", [&](const json& v, const std::string& p) { read_options(r, v, p, &s.options); });
   if (!doc.contains("bodies")) r.fail("bodies", "required (an array of bodies)");

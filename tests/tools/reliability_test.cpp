@@ -259,3 +259,86 @@ TEST_CASE("magsolve: converged means M = f(H), not only a small change per itera
   CHECK(c.out.find("converged=false criterion_met=true") != std::string::npos);
   CHECK(c.out.find("relative residual") != std::string::npos);  // the note on stderr
 }
+
+TEST_CASE("magsim-scene: magnitudes ODE cannot take are refused up front with the JSON path, exit 1", "[reliability]") {
+  // each of these used to fail inside ODE on step 1 (dxNormalize4's assertion, inf/NaN
+  // velocities) or in the magnetics; see engine/limits.hpp
+  struct Case {
+    const char* file;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"mass_1e-300", "bodies[1].mass: must be 0 (density x volume) or in [1e-12, 1e+12] kg"},
+      {"mass_1e300", "bodies[1].mass: must be 0 (density x volume) or in [1e-12, 1e+12] kg"},
+      {"density_1e-300", "body 1 'ball_0': mass 5.23599e-307 kg (density x volume) is outside"},
+      {"Ms_1e300", "bodies[1].moments[0].Ms: magnitude 1e+300 A/m exceeds 1e+08 A/m"},
+      {"Ms_-1e300", "bodies[1].moments[0].Ms: must be > 0"},
+      {"gravity_1e300", "options.gravity: magnitude 1e+300 m/s^2 exceeds"},
+      {"gravity_-1e300", "options.gravity: magnitude 1e+300 m/s^2 exceeds"},
+      {"velocity_1e300", "bodies[1].velocity: magnitude 1e+300 m/s exceeds 1e+06 m/s"},
+      {"velocity_-1e300", "bodies[1].velocity: magnitude 1e+300 m/s exceeds 1e+06 m/s"},
+      {"angular_velocity_1e300", "bodies[1].angular_velocity: magnitude 1e+300 rad/s exceeds"},
+      {"shape_offset_1e300", "bodies[1].shapes[0].offset: magnitude 1e+300 m exceeds 1e+06 m"},
+      {"shape_offset_-1e300", "bodies[1].shapes[0].offset: magnitude 1e+300 m exceeds 1e+06 m"},
+      {"moment_offset_1e300", "bodies[1].moments[0].offset: magnitude 1e+300 m exceeds 1e+06 m"},
+      {"moment_offset_-1e300", "bodies[1].moments[0].offset: magnitude 1e+300 m exceeds 1e+06 m"},
+      {"position_1e300", "bodies[1].position: magnitude 1e+300 m exceeds"},
+      {"moment_1e300", "bodies[0].moments[0].moment: magnitude 1e+300 A·m^2 exceeds 1e+12"},
+      {"volume_1e300", "bodies[1].moments[0].volume: magnitude 1e+300 m^3 exceeds 1000 m^3"},
+      {"size_1e300", "bodies[1].shapes[0].size: magnitude 1e+300 m exceeds"},
+      {"H0_1e300", "H0: magnitude 1e+300 A/m exceeds 1e+12 A/m"},
+  };
+  for (const Case& c : cases) {
+    const std::string out = tmp(std::string("magnitude_") + c.file);
+    const CommandResult r = scene(input(std::string("magnitudes/") + c.file + ".json") + " --steps 5 --no-render --out " + out);
+    INFO(c.file << ": " << r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find(c.says) != std::string::npos);
+    CHECK(lines(r.out) == 1);
+    CHECK(!std::ifstream(out + "/summary.json").good());
+  }
+  // registry scenes go through the same limits (Simulation's validation)
+  const CommandResult s = scene("balls_up --strength 1e300 --steps 1 --no-render --out " + tmp("strength"));
+  INFO(s.out);
+  CHECK(s.code == 1);
+  CHECK(s.out.find("moments[0].moment: magnitude 8e+300") != std::string::npos);
+}
+
+TEST_CASE("magsim-scene: options.threads has the --threads cap", "[reliability]") {
+  const CommandResult r = scene(input("threads_too_many.json") + " --steps 1 --no-render --out " + tmp("threads_file"));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("options.threads: at most") != std::string::npos);
+  CHECK(r.out.find("got 1000") != std::string::npos);
+}
+
+TEST_CASE("magsim-scene: an output folder that cannot be made is an I/O error, exit 3", "[reliability]") {
+  const std::string file = tmp("not_a_dir");
+  { std::ofstream(file) << "x"; }
+  const CommandResult r = scene("balls_up --count 5 --steps 1 --no-render --out " + file + "/sub");
+  INFO(r.out);
+  CHECK(r.code == 3);
+  CHECK(r.out.find("cannot create the directory") != std::string::npos);
+  const CommandResult f = scene("balls_up --count 5 --steps 1 --no-render --out " + file);
+  INFO(f.out);
+  CHECK(f.code == 3);
+  CHECK(f.out.find("exists and is not a directory") != std::string::npos);
+}
+
+TEST_CASE("magsim-scene: a degenerate camera is an error naming it, not blank frames", "[reliability]") {
+  struct Case {
+    const char* file;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"camera_eye_is_target", "camera: eye [0.1, 0.2, 0.3] and target [0.1, 0.2, 0.3] are the same point"},
+      {"camera_up_zero", "camera: up must not be zero"},
+      {"camera_up_parallel", "camera: up [0, 0, 1] is parallel to the view direction"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = scene(input(std::string(c.file) + ".json") + " --steps 1 --no-render --out " + tmp(c.file));
+    INFO(c.file << ": " << r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find(c.says) != std::string::npos);
+  }
+}
