@@ -342,3 +342,17 @@ TEST_CASE("magsim-scene: a degenerate camera is an error naming it, not blank fr
     CHECK(r.out.find(c.says) != std::string::npos);
   }
 }
+
+TEST_CASE("magsim-scene: the issue's other blow-ups end in exit 2 with the error in summary.json", "[reliability]") {
+  // a ball inside a 1e4 A·m² magnet (2,700 m/s, exit 0 before) and two balls 1e-12 m apart
+  for (const char* name : {"ball_inside_magnet", "balls_1e-12_apart"}) {
+    const std::string out = tmp(name);
+    const CommandResult r = scene(input(std::string(name) + ".json") + " --steps 300 --no-render --out " + out);
+    INFO(name << ": " << r.out);
+    CHECK(r.code == 2);
+    CHECK(r.out.find("body 1 'ball_0': speed") != std::string::npos);
+    std::ifstream f(out + "/summary.json");
+    const std::string summary((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    CHECK(summary.find("exceeds options.max_body_speed") != std::string::npos);
+  }
+}
