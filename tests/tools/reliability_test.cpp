@@ -356,3 +356,23 @@ TEST_CASE("magsim-scene: the issue's other blow-ups end in exit 2 with the error
     CHECK(summary.find("exceeds options.max_body_speed") != std::string::npos);
   }
 }
+
+TEST_CASE("magsolve: a long Newton reference reports its progress on stderr", "[reliability]") {
+  // 500 induced moments (the bound is 3153): each Newton step is reported, stdout stays JSON
+  const std::string path = tmp("n500.json");
+  {
+    std::ofstream f(path);
+    f << "{\"external_field\": [0, 0, 1000], \"moments\": [";
+    for (int i = 0; i < 500; ++i)
+      f << (i ? "," : "") << "{\"position\": [" << 0.02 * (i % 25) << ", " << 0.02 * (i / 25)
+        << ", 0], \"volume\": 5e-7, \"Ms\": 1.6e6, \"kind\": \"induced\"}";
+    f << "]}";
+  }
+  const CommandResult r = solve(path + " --method anderson");
+  CHECK(r.code == 0);
+  CHECK(r.out.find("Newton reference for 500 induced moments") != std::string::npos);
+  CHECK(r.out.find("Newton reference step 1, relative residual") != std::string::npos);
+  // small cases stay quiet
+  const CommandResult small = solve(example("touching_spheres.json"));
+  CHECK(small.out.find("Newton reference") == std::string::npos);
+}
