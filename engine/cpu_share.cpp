@@ -65,9 +65,9 @@ CpuSample sample_cpu(const std::string* stat_text) {
   return s;
 }
 
-int threads_for_load(double others, int cores, int max_threads) {
+int threads_for_load(double others, int cores, int max_threads, double slack) {
   const double room = static_cast<double>(cores) - std::clamp(others, 0.0, static_cast<double>(cores));
-  const int n = static_cast<int>(std::floor(room + 0.25));
+  const int n = static_cast<int>(std::floor(room + slack));
   return std::clamp(n, 1, std::max(1, max_threads));
 }
 
@@ -89,9 +89,10 @@ int ThreadGovernor::threads() {
   }
   others_ = std::max(0.0, ((s.busy_s - last_.busy_s) - (s.own_s - last_.own_s)) / window);
   last_ = s;
-  const int want = threads_for_load(others_, s.cores, max_threads_);
-  if (want < current_) {
-    current_ = want;
+  const int down = threads_for_load(others_, s.cores, max_threads_, 0.6);
+  const int want = threads_for_load(others_, s.cores, max_threads_, 0.25);
+  if (down < current_) {
+    current_ = down;
     raise_votes_ = 0;
   } else if (want > current_) {
     if (++raise_votes_ >= 2) {

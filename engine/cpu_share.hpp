@@ -8,9 +8,12 @@
 // process may run on and answers with a thread count that fits into the rest:
 //
 //   others = (busy time of our cores in /proc/stat − this process's CPU time) / window
-//   threads = clamp(floor(cores − others + 0.25), 1, max_threads)
+//   more threads:  up to clamp(floor(cores − others + 0.25), 1, max_threads)
+//   fewer threads: down to clamp(floor(cores − others + 0.6), 1, max_threads)
 //
-// so on 2 cores two threads need the others below 0.25 of a core. The estimate is taken over
+// so on 2 cores two threads need the others below 0.25 of a core to start and above 0.4 to
+// stop (one busy process measures 0.67 while we run two threads: it always stops them; the
+// gap keeps the tick-sampled estimate's ±0.2 from flapping on a quiet machine). The estimate is taken over
 // windows of at least `period` of wall time (0.25 s by default; the first window starts when
 // the governor is made, so a scene's set-up time counts, and may be as short as 0.1 s); fewer threads are taken at once,
 // more only after two windows in a row allow them. Where /proc/stat cannot be read
@@ -36,8 +39,9 @@ struct CpuSample {
 /// process's CPU clock.
 CpuSample sample_cpu(const std::string* stat_text = nullptr);
 
-/// The thread count for `cores` cores of which other processes use `others` (in cores).
-int threads_for_load(double others, int cores, int max_threads);
+/// The thread count for `cores` cores of which other processes use `others` (in cores):
+/// floor(cores − others + slack), at least 1, at most max_threads.
+int threads_for_load(double others, int cores, int max_threads, double slack = 0.25);
 
 class ThreadGovernor {
  public:

@@ -26,6 +26,10 @@ TEST_CASE("threads_for_load leaves other processes their cores", "[cpu_share][re
   CHECK(threads_for_load(0.0, 8, 4) == 4);
   CHECK(threads_for_load(1.0, 8, 8) == 7);
   CHECK(threads_for_load(-1.0, 2, 2) == 2);  // clamped
+  // the governor's slack for going down (0.6): a stray 0.3 of a core keeps two threads,
+  // one busy process (0.67 while we run two) does not
+  CHECK(threads_for_load(0.3, 2, 2, 0.6) == 2);
+  CHECK(threads_for_load(2.0 / 3.0, 2, 2, 0.6) == 1);
 }
 
 TEST_CASE("sample_cpu reads the cores of the affinity mask from /proc/stat text", "[cpu_share][reliability]") {
