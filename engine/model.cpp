@@ -5,10 +5,13 @@
 // body. Validation happens here too, so the step can assume finite, positive inputs.
 #include "engine/model.hpp"
 
+#include "engine/limits.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace magsim::engine {
 
@@ -34,6 +37,13 @@ std::string fmt(const Vec3& v) {
   throw std::invalid_argument(where + ": " + what);
 }
 
+// limits.hpp: a finite magnitude beyond what ODE (or the magnetics) can take
+void check_at_most(const std::string& where, double magnitude, double max, const char* unit) {
+  if (magnitude > max)
+    fail(where, "magnitude " + fmt(magnitude) + " " + unit + " exceeds " + fmt(max) + " " + unit +
+                    " (engine/limits.hpp: beyond it the rigid-body or magnetics arithmetic overflows)");
+}
+
 std::string body_where(int i, const std::string& name) {
   return "body " + std::to_string(i) + " '" + name + "'";
 }
@@ -41,6 +51,7 @@ std::string body_where(int i, const std::string& name) {
 void check_options(const SimOptions& o, const Vec3& H0) {
   if (!(o.dt > 0 && o.dt <= 0.1)) fail("options.dt", "must be in (0, 0.1] s (got " + fmt(o.dt) + ")");
   if (!finite(o.gravity)) fail("options.gravity", "must be finite (got " + fmt(o.gravity) + ")");
+  check_at_most("options.gravity", o.gravity.stableNorm(), limits::kMaxGravity, "m/s^2");
   if (!(o.friction >= 0 && std::isfinite(o.friction)))
     fail("options.friction", "must be >= 0 and finite (got " + fmt(o.friction) + ")");
   if (!(o.restitution >= 0 && o.restitution <= 1))
@@ -64,6 +75,11 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (!std::isfinite(o.contact_margin))
     fail("options.contact_margin", "must be finite (< 0 = auto, 0 = off) (got " + fmt(o.contact_margin) + ")");
   if (o.threads < 0) fail("options.threads", "must be >= 0 (got " + std::to_string(o.threads) + ")");
+  // the same cap as magsim-scene --threads: more only slows the run, 1e5 crashes libgomp
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  if (o.threads > 4 * cores)
+    fail("options.threads", "at most " + std::to_string(4 * cores) + " (4 x the " + std::to_string(cores) +
+                                " cores), got " + std::to_string(o.threads));
   if (!(o.rolling_friction >= 0 && std::isfinite(o.rolling_friction)))
     fail("options.rolling_friction", "must be >= 0 and finite (m) (got " + fmt(o.rolling_friction) + ")");
   if (o.max_substeps < 1 || o.max_substeps > 64)
@@ -71,6 +87,7 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))
     fail("options.substep_reach", "must be > 0 and finite (got " + fmt(o.substep_reach) + ")");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
+  check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
   mag::DynamicsOptions d = o.magnetics;
   d.method = o.method;
   const std::string e = mag::validate(d);
@@ -83,6 +100,8 @@ void check_shape(const std::string& where, int k, const ShapeDesc& s) {
   if (!finite(s.rotation) || s.rotation.norm() < 1e-12)
     fail(w + ".rotation", "must be a finite non-zero quaternion");
   if (!finite(s.size)) fail(w + ".size", "must be finite (got " + fmt(s.size) + ")");
+  check_at_most(w + ".offset", s.offset.stableNorm(), limits::kMaxCoordinate, "m");
+  check_at_most(w + ".size", s.size.cwiseAbs().maxCoeff(), limits::kMaxSize, "m");
   switch (s.kind) {
     case ShapeKind::Sphere:
       if (!(s.size.x() > 0)) fail(w + ".size", "sphere radius must be > 0 (got " + fmt(s.size.x()) + ")");
@@ -102,15 +121,20 @@ void check_shape(const std::string& where, int k, const ShapeDesc& s) {
 void check_moment(const std::string& where, int k, const MomentDesc& m) {
   const std::string w = where + ": moments[" + std::to_string(k) + "]";
   if (!finite(m.offset)) fail(w + ".offset", "must be finite (got " + fmt(m.offset) + ")");
+  check_at_most(w + ".offset", m.offset.stableNorm(), limits::kMaxCoordinate, "m");
   if (!(m.volume > 0 && std::isfinite(m.volume)))
     fail(w + ".volume", "must be > 0 and finite (got " + fmt(m.volume) + ")");
+  check_at_most(w + ".volume", m.volume, limits::kMaxVolume, "m^3");
   if (!std::isfinite(m.interaction_radius))
     fail(w + ".interaction_radius", "must be finite: >= 0 (m), or < 0 for auto (got " +
                                         fmt(m.interaction_radius) + ")");
   if (m.permanent) {
     if (!finite(m.moment)) fail(w + ".moment", "must be finite (got " + fmt(m.moment) + ")");
+    check_at_most(w + ".moment", m.moment.stableNorm(), limits::kMaxMoment, "A·m^2");
   } else if (!(m.Ms > 0 && std::isfinite(m.Ms))) {
     fail(w + ".Ms", "must be > 0 and finite (got " + fmt(m.Ms) + ")");
+  } else {
+    check_at_most(w + ".Ms", m.Ms, limits::kMaxMs, "A/m");
   }
 }
 
@@ -122,6 +146,9 @@ void check_body(int i, const BodyDesc& b, const std::string& name) {
   if (!finite(b.velocity)) fail(w, "velocity is not finite (" + fmt(b.velocity) + ")");
   if (!finite(b.angular_velocity))
     fail(w, "angular_velocity is not finite (" + fmt(b.angular_velocity) + ")");
+  check_at_most(w + ": position", b.position.stableNorm(), limits::kMaxCoordinate, "m");
+  check_at_most(w + ": velocity", b.velocity.stableNorm(), limits::kMaxSpeed, "m/s");
+  check_at_most(w + ": angular_velocity", b.angular_velocity.stableNorm(), limits::kMaxAngularSpeed, "rad/s");
   if (!(b.mass >= 0 && std::isfinite(b.mass)))
     fail(w, "mass must be >= 0 and finite, 0 = density x volume (got " + fmt(b.mass) + ")");
   if (b.type == BodyType::Dynamic && b.mass == 0 && !(b.density > 0 && std::isfinite(b.density)))
@@ -214,6 +241,18 @@ static double inscribed_radius(const std::vector<ShapeDesc>& shapes, const Vec3&
   return best;
 }
 
+std::string camera_error(const render::Camera& c) {
+  const Eigen::Vector3d eye = c.eye.cast<double>(), target = c.target.cast<double>(), up = c.up.cast<double>();
+  const Eigen::Vector3d view = target - eye;
+  const double scale = std::max({1.0, eye.norm(), target.norm()});
+  if (!(view.norm() > 1e-6 * scale))
+    return "eye " + fmt(eye) + " and target " + fmt(target) + " are the same point: no view direction";
+  if (!(up.norm() > 0)) return "up must not be zero";
+  if (!(view.normalized().cross(up.normalized()).norm() > 1e-3))
+    return "up " + fmt(up) + " is parallel to the view direction target - eye " + fmt(view) + ": the roll is undefined";
+  return {};
+}
+
 Model compile_model(const SceneDesc& scene) {
   check_options(scene.options, scene.H0);
 
@@ -221,6 +260,7 @@ Model compile_model(const SceneDesc& scene) {
   m.options = scene.options;
   m.options.magnetics.method = scene.options.method;
   m.H0 = scene.H0;
+  if (const std::string e = camera_error(scene.camera); !e.empty()) fail("camera", e);
   m.camera = scene.camera;
   m.name = scene.name;
   m.description = scene.description;
@@ -261,6 +301,11 @@ Model compile_model(const SceneDesc& scene) {
       }
       if (!(mass > 0 && std::isfinite(mass) && inertia.allFinite()))
         fail(body_where(i, name), "mass properties are not positive and finite (mass " + fmt(mass) + ")");
+      if (mass < limits::kMinMass || mass > limits::kMaxMass)
+        fail(body_where(i, name), std::string("mass ") + fmt(mass) + " kg (" +
+                                      (b.mass > 0 ? "given" : "density x volume") + ") is outside [" +
+                                      fmt(limits::kMinMass) + ", " + fmt(limits::kMaxMass) +
+                                      "] kg (engine/limits.hpp: beyond it ODE's arithmetic overflows)");
     } else if (b.type == BodyType::Kinematic) {
       // ODE needs a valid mass on every body; a kinematic body never uses it
       mass = 1.0;

@@ -90,6 +90,10 @@ struct Model {
 ///   "body 3 'ball_3': shapes[0].size: sphere radius must be > 0 (got -0.01)".
 Model compile_model(const SceneDesc& scene);
 
+/// Empty when the camera can render, else why not: eye and target at one point (nothing to
+/// look along: blank frames), or up zero or parallel to the view direction (no roll).
+std::string camera_error(const render::Camera& c);
+
 /// Mass properties of one shape of density ρ about its own centre, in its own axes:
 /// returns the volume (m³) and writes I/ρ (m⁵) to *inertia_per_density.
 double shape_volume_inertia(ShapeKind kind, const Vec3& size, Mat3* inertia_per_density);

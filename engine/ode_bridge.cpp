@@ -33,10 +33,29 @@ bool g_ode_poisoned = false;
 
 // ODE's error and debug handlers abort() after the call; throwing from them unwinds
 // through ODE (C++ compiled with exceptions) back to the Simulation instead.
+// ODE's message handler (non-fatal warnings, e.g. a bad mass) prints them; the last one is
+// kept and added to the next failure, so a run that ODE then stops says why.
+std::mutex g_message_mutex;
+std::string g_last_message;
+
+void keep_ode_message(int errnum, const char* msg, va_list ap) {
+  char text[512];
+  std::vsnprintf(text, sizeof text, msg, ap);
+  std::fprintf(stderr, "ODE message %d: %s\n", errnum, text);
+  std::lock_guard<std::mutex> lock(g_message_mutex);
+  g_last_message = text;
+}
+
 void throw_ode_failure(int errnum, const char* msg, va_list ap) {
   char text[512];
   std::vsnprintf(text, sizeof text, msg, ap);
-  throw OdeFailure("ODE error " + std::to_string(errnum) + ": " + text);
+  std::string what = "ODE error " + std::to_string(errnum) + ": " + text;
+  {
+    std::lock_guard<std::mutex> lock(g_message_mutex);
+    if (!g_last_message.empty()) what += " (after ODE's message: " + g_last_message + ")";
+    g_last_message.clear();
+  }
+  throw OdeFailure(what);
 }
 
 void ode_acquire() {
@@ -48,6 +67,7 @@ void ode_acquire() {
     }
     dSetErrorHandler(&throw_ode_failure);
     dSetDebugHandler(&throw_ode_failure);
+    dSetMessageHandler(&keep_ode_message);
     g_ode_open = true;
   }
 }
@@ -58,6 +78,7 @@ void ode_release(bool poisoned) {
   if (--g_ode_users == 0 && !g_ode_poisoned) {
     dSetErrorHandler(nullptr);
     dSetDebugHandler(nullptr);
+    dSetMessageHandler(nullptr);
     dCloseODE();
     g_ode_open = false;
   }

@@ -7,6 +7,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace magsim::engine {
@@ -47,6 +48,12 @@ Simulation::Simulation(const SceneDesc& scene)
   omp_threads_ = m.options.threads > 0 ? m.options.threads
                  : m.nmoment < kParallelMoments ? 1
                                                 : all_threads;
+  chosen_threads_ = omp_threads_;
+}
+
+void Simulation::limit_default_threads(int n) {
+  if (model_->options.threads > 0) return;  // the user's count
+  omp_threads_ = std::max(1, std::min(n, chosen_threads_));
 }
 
 Simulation::~Simulation() = default;

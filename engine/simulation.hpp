@@ -75,6 +75,14 @@ class Simulation {
   /// The BodyDesc frame's origin, x − R c (differs from the COM for composite bodies).
   Vec3 body_origin(int i) const;
 
+  /// OpenMP threads the next step's magnetics run with.
+  int threads() const { return omp_threads_; }
+  /// Caps the thread count the simulation chose itself (SimOptions::threads = 0) at n >= 1,
+  /// e.g. from a ThreadGovernor (cpu_share.hpp) on a busy machine; never raises it above that
+  /// choice, and an explicit SimOptions::threads is kept. States do not depend on it (the
+  /// kernels are bitwise the same for any thread count).
+  void limit_default_threads(int n);
+
   /// Test hook of the safety check: the next step overwrites body i's linear velocity in
   /// ODE with v just before the rigid step (v may be NaN).
   void inject_velocity_for_testing(int body, const Vec3& v);
@@ -91,6 +99,7 @@ class Simulation {
   StepProfile profile_;
   EnergyAudit energy_;      ///< committed with state_ at the end of each step
   int omp_threads_ = 1;     ///< OpenMP threads the magnetics run with (see step.cpp)
+  int chosen_threads_ = 1;  ///< the count chosen at construction (the cap's ceiling)
   int inject_body_ = -1;
   Vec3 inject_velocity_ = Vec3::Zero();
 };

@@ -66,7 +66,7 @@ Eigen::VectorXd residual(const MomentSet& set, const Problem& P, Curve curve,
 }  // namespace
 
 ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field, double rel_tol,
-                       int max_steps) {
+                       int max_steps, const std::function<void(int, double)>& on_step) {
   ExactStats st;
   const Problem P = build(*set, field);
   const int k = static_cast<int>(P.idx.size());
@@ -110,6 +110,7 @@ ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field, d
     H = Hn;
     R = Rn;
     st.newton_steps = step + 1;
+    if (on_step) on_step(st.newton_steps, rel(R, M));
   }
   st.residual = rel(R, M);
   st.converged = st.converged || st.residual <= rel_tol;

@@ -103,7 +103,19 @@ class JsonReader {
     const std::vector<double> v = numbers(j, path, "3 numbers [x, y, z]");
     if (v.size() != 3) fail(path, "must be 3 numbers [x, y, z]");
     return Eigen::Vector3d(v[0], v[1], v[2]);
+  }  // engine/limits.hpp: finite magnitudes beyond what ODE (or the magnetics) can take
+  void at_most(const std::string& path, double magnitude, double max, const char* unit) const {
+    if (magnitude > max)
+      fail(path, "magnitude " + fmt(magnitude) + " " + unit + " exceeds " + fmt(max) + " " + unit +
+                     " (engine/limits.hpp: beyond it the rigid-body or magnetics arithmetic overflows)");
   }
+  /// vec3 whose length is at most max (unit named in the error).
+  Eigen::Vector3d bounded(const nlohmann::json& j, const std::string& path, double max, const char* unit) const {
+    const Eigen::Vector3d v = vec3(j, path);
+    at_most(path, v.stableNorm(), max, unit);
+    return v;
+  }
+
   Eigen::Vector3f vec3f(const nlohmann::json& j, const std::string& path) const { return vec3(j, path).cast<float>(); }
   Eigen::Quaterniond quat(const nlohmann::json& j, const std::string& path) const {
     const std::vector<double> v = numbers(j, path, "4 numbers [w, x, y, z]");

@@ -3,6 +3,7 @@
 // writes every field, so the two are each other's inverse (tests/engine/options_json_test.cpp).
 #include "scenes/options_json.hpp"
 
+#include "engine/limits.hpp"
 #include "magnetics/magnetization.hpp"
 
 namespace magsim::scenes {
@@ -155,7 +156,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
     o->dt = r.number(v, p);
     if (!(o->dt > 0 && o->dt <= 0.1)) r.fail(p, "must be in (0, 0.1] s (got " + JsonReader::fmt(o->dt) + ")");
   });
-  if_present(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.vec3(v, p); });
+  if_present(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.bounded(v, p, engine::limits::kMaxGravity, "m/s^2"); });
   if_present(j, "ground", path, [&](const json& v, const std::string& p) { o->ground = r.boolean(v, p); });
   if_present(j, "friction", path, [&](const json& v, const std::string& p) { o->friction = r.non_negative(v, p); });
   if_present(j, "restitution", path, [&](const json& v, const std::string& p) { o->restitution = r.in_range(v, p, 0, 1); });

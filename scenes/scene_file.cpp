@@ -54,6 +54,8 @@
 //   "scene.json: bodies[3].shapes[0].size: must be 3 positive numbers (half extents)".
 #include "scenes/scene_file.hpp"
 
+#include "engine/limits.hpp"
+#include "engine/model.hpp"
 #include "magnetics/magnetization.hpp"
 #include "scenes/json_reader.hpp"
 #include "scenes/options_json.hpp"
@@ -135,27 +137,30 @@ ShapeDesc read_shape(const JsonReader& r, const json& j, const std::string& path
   r.keys(j, path, {"kind", "offset", "rotation", "size"});
   ShapeDesc s;
   if_present(j, "kind", path, [&](const json& v, const std::string& p) { s.kind = shape_kind(r, v, p); });
-  if_present(j, "offset", path, [&](const json& v, const std::string& p) { s.offset = r.vec3(v, p); });
+  if_present(j, "offset", path, [&](const json& v, const std::string& p) { s.offset = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   if_present(j, "rotation", path, [&](const json& v, const std::string& p) { s.rotation = r.quat(v, p); });
   if (!j.contains("size")) r.fail(JsonReader::join(path, "size"), "required");
   s.size = shape_size(r, s.kind, j.at("size"), JsonReader::join(path, "size"));
+  r.at_most(JsonReader::join(path, "size"), s.size.cwiseAbs().maxCoeff(), engine::limits::kMaxSize, "m");
   return s;
 }
 
 MomentDesc read_moment(const JsonReader& r, const json& j, const std::string& path) {
   r.keys(j, path, {"offset", "permanent", "volume", "Ms", "moment", "interaction_radius"});
   MomentDesc m;
-  if_present(j, "offset", path, [&](const json& v, const std::string& p) { m.offset = r.vec3(v, p); });
+  if_present(j, "offset", path, [&](const json& v, const std::string& p) { m.offset = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   if_present(j, "permanent", path, [&](const json& v, const std::string& p) { m.permanent = r.boolean(v, p); });
   if (!j.contains("volume")) r.fail(JsonReader::join(path, "volume"), "required (> 0, m³)");
   m.volume = r.positive(j.at("volume"), JsonReader::join(path, "volume"));
+  r.at_most(JsonReader::join(path, "volume"), m.volume, engine::limits::kMaxVolume, "m^3");
   if_present(j, "Ms", path, [&](const json& v, const std::string& p) {
     if (m.permanent) r.fail(p, "only for induced moments (\"permanent\": false)");
     m.Ms = r.positive(v, p);
+    r.at_most(p, m.Ms, engine::limits::kMaxMs, "A/m");
   });
   if_present(j, "moment", path, [&](const json& v, const std::string& p) {
     if (!m.permanent) r.fail(p, "only for permanent moments (\"permanent\": true)");
-    m.moment = r.vec3(v, p);
+    m.moment = r.bounded(v, p, engine::limits::kMaxMoment, "A·m^2");
   });
   if_present(j, "interaction_radius", path, [&](const json& v, const std::string& p) { m.interaction_radius = r.number(v, p); });
   // a permanent moment without "moment" used to load as a zero magnet
@@ -171,12 +176,20 @@ BodyDesc read_body(const JsonReader& r, const json& j, const std::string& path, 
   b.name = "body_" + std::to_string(i);
   if_present(j, "name", path, [&](const json& v, const std::string& p) { b.name = r.string(v, p); });
   if_present(j, "type", path, [&](const json& v, const std::string& p) { b.type = body_type(r, v, p); });
-  if_present(j, "position", path, [&](const json& v, const std::string& p) { b.position = r.vec3(v, p); });
+  if_present(j, "position", path, [&](const json& v, const std::string& p) { b.position = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   if_present(j, "orientation", path, [&](const json& v, const std::string& p) { b.orientation = r.quat(v, p); });
-  if_present(j, "velocity", path, [&](const json& v, const std::string& p) { b.velocity = r.vec3(v, p); });
-  if_present(j, "angular_velocity", path, [&](const json& v, const std::string& p) { b.angular_velocity = r.vec3(v, p); });
+  if_present(j, "velocity", path, [&](const json& v, const std::string& p) { b.velocity = r.bounded(v, p, engine::limits::kMaxSpeed, "m/s"); });
+  if_present(j, "angular_velocity", path, [&](const json& v, const std::string& p) {
+    b.angular_velocity = r.bounded(v, p, engine::limits::kMaxAngularSpeed, "rad/s");
+  });
   if_present(j, "density", path, [&](const json& v, const std::string& p) { b.density = r.positive(v, p); });
-  if_present(j, "mass", path, [&](const json& v, const std::string& p) { b.mass = r.non_negative(v, p); });
+  if_present(j, "mass", path, [&](const json& v, const std::string& p) {
+    b.mass = r.non_negative(v, p);
+    if (b.mass > 0 && (b.mass < engine::limits::kMinMass || b.mass > engine::limits::kMaxMass))
+      r.fail(p, "must be 0 (density x volume) or in [" + JsonReader::fmt(engine::limits::kMinMass) + ", " +
+                    JsonReader::fmt(engine::limits::kMaxMass) + "] kg (got " + JsonReader::fmt(b.mass) +
+                    "; engine/limits.hpp: beyond it ODE's arithmetic overflows)");
+  });
   if_present(j, "color", path, [&](const json& v, const std::string& p) { b.color = r.color(v, p); });
   if_present(j, "visible", path, [&](const json& v, const std::string& p) { b.visible = r.boolean(v, p); });
   if_present(j, "magnet", path, [&](const json& v, const std::string& p) { b.magnet = r.boolean(v, p); });
@@ -203,6 +216,8 @@ void read_camera(const JsonReader& r, const json& j, const std::string& path, re
   });
   if_present(j, "z_near", path, [&](const json& v, const std::string& p) { c->z_near = static_cast<float>(r.non_negative(v, p)); });
   if_present(j, "z_far", path, [&](const json& v, const std::string& p) { c->z_far = static_cast<float>(r.non_negative(v, p)); });
+  // a degenerate view rendered blank (eye = target) or a guessed orientation (up ∥ view)
+  if (const std::string e = engine::camera_error(*c); !e.empty()) r.fail(path, e);
 }
 
 // The scene name becomes the output folder out/<name>_<method>: no path separators, no "."
@@ -260,7 +275,7 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   if_present(doc, "modelling_level", "", [&](const json& v, const std::string& p) { s.modelling_level = r.string(v, p); });
   if_present(doc, "default_seconds", "", [&](const json& v, const std::string& p) { s.default_seconds = r.positive(v, p); });
   if_present(doc, "escape_radius", "", [&](const json& v, const std::string& p) { s.escape_radius = r.non_negative(v, p); });
-  if_present(doc, "H0", "", [&](const json& v, const std::string& p) { s.H0 = r.vec3(v, p); });
+  if_present(doc, "H0", "", [&](const json& v, const std::string& p) { s.H0 = r.bounded(v, p, engine::limits::kMaxField, "A/m"); });
   if_present(doc, "camera", "", [&](const json& v, const std::string& p) { read_camera(r, v, p, &s.camera); });
   if_present(doc, "options", "", [&](const json& v, const std::string& p) { from_json(r, v, p, &s.options); });
   if (!doc.contains("bodies")) r.fail("bodies", "required (an array of bodies)");

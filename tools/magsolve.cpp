@@ -4,6 +4,7 @@
 //
 // Exit codes (the same in magsim-scene): 0 done, 1 bad input or flags, 2 the solve failed
 // (non-finite solution), 3 I/O error (the output could not be written).
+#include "magnetics/curves.hpp"
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
 #include "scenes/json_reader.hpp"
@@ -14,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -23,6 +25,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <numeric>
 #include <stdexcept>
 
 using magsim::mag::Vec3;
@@ -43,7 +46,7 @@ struct InputError : std::runtime_error {
 // The case file, read with the scene files' checked reader (scenes/json_reader.hpp): every
 // error is "<file>: <json path>: <what>". "magnetics" (optional) is a scene file's
 // options.magnetics, read by the same from_json (scenes/options_json.hpp).
-mag::MomentSet parse_moments(const magsim::scenes::JsonReader& r, const json& doc, double softening) {
+mag::MomentSet parse_moments(const magsim::scenes::JsonReader& r, const json& doc) {
   mag::MomentSet set;
   if (doc.contains("external_field")) set.H0 = r.vec3(doc["external_field"], "external_field");
   if (!doc.contains("moments")) r.fail("moments", "missing (a non-empty array of moments)");
@@ -71,14 +74,60 @@ mag::MomentSet parse_moments(const magsim::scenes::JsonReader& r, const json& do
       r.fail(w + ".kind", "must be \"induced\" or \"permanent\", got \"" + kind + "\"");
     }
   }
-  if (softening == 0.0) {
-    for (std::size_t i = 0; i < set.size(); ++i)
-      for (std::size_t j = 0; j < i; ++j)
-        if (set.position[i] == set.position[j])
-          r.fail("", "moments[" + std::to_string(j) + "] and moments[" + std::to_string(i) +
-                         "] are at the same point; give --softening EPS to allow it");
-  }
   return set;
+}
+
+// Two moments closer than this fraction of the sum of their sizes are refused without
+// --softening: the dipole sum grows as 1/r⁴ (two moments 1e-12 m apart gave F = 4e41 N), and
+// closer than this the two spheres' centres lie inside each other.
+constexpr double kMinSeparation = 0.5;
+
+// A moment's size: the radius of the sphere of its volume.
+double moment_radius(double volume) { return std::cbrt(3.0 * volume / (4.0 * 3.14159265358979323846)); }
+
+// Refuses the first pair (in index order of the closer moment) closer than kMinSeparation ×
+// (a_i + a_j). A sweep along x sorted, so 10^5 spread-out moments cost no 10^10 pairs.
+void check_separations(const mag::MomentSet& set) {
+  const std::size_t n = set.size();
+  std::vector<double> a(n);
+  double a_max = 0.0;
+  for (std::size_t j = 0; j < n; ++j) a_max = std::max(a_max, a[j] = moment_radius(set.volume[j]));
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t p, std::size_t q) { return set.position[p].x() < set.position[q].x(); });
+  std::size_t best_i = n, best_j = n;
+  double best_d = 0.0, best_min = 0.0;
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::size_t i = order[s];
+    for (std::size_t t = s + 1; t < n; ++t) {
+      const std::size_t j = order[t];
+      if (set.position[j].x() - set.position[i].x() >= kMinSeparation * (a[i] + a_max)) break;
+      const double d = (set.position[j] - set.position[i]).norm();
+      const double dmin = kMinSeparation * (a[i] + a[j]);
+      if (d >= dmin) continue;
+      const std::size_t lo = std::min(i, j), hi = std::max(i, j);
+      if (best_i == n || lo < best_i || (lo == best_i && hi < best_j)) {
+        best_i = lo;
+        best_j = hi;
+        best_d = d;
+        best_min = dmin;
+      }
+    }
+  }
+  if (best_i == n) return;
+  char apart[64];
+  if (best_d == 0.0)
+    std::snprintf(apart, sizeof apart, "at the same point");
+  else
+    std::snprintf(apart, sizeof apart, "%.6g m apart", best_d);
+  char msg[400];
+  std::snprintf(msg, sizeof msg,
+                "moments[%zu] and moments[%zu] are %s, closer than %.6g m = %g x the sum of "
+                "their radii (%.6g + %.6g m, spheres of their volumes); the dipole field diverges "
+                "there: give --softening EPS to allow it",
+                best_i, best_j, apart, best_min, kMinSeparation, a[best_i], a[best_j]);
+  throw InputError(msg);
 }
 
 json vec_json(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
@@ -109,6 +158,9 @@ double reference_bytes(std::size_t induced) {
   return 3.0 * n3 * n3 * sizeof(double);
 }
 
+// from this many induced moments the Newton reference reports each step on stderr
+constexpr std::size_t kProgressMoments = 500;
+
 int run(int argc, char** argv) {
   CLI::App app{
       "magsolve — solve one configuration of induced and permanent magnetic moments.\n"
@@ -116,7 +168,7 @@ int run(int argc, char** argv) {
       "F_classic (eq. 13) in newtons, the iterations taken, convergence, and e_M (eq. 12)\n"
       "against the Newton ground truth of the method's curve (eq. 10; eq. 7 for kim2018)."};
   std::string path, method_name = "ours", format = "json";
-  double dt = 100e-9, tol = 1e-6, softening = 0.0;
+  double dt = 100e-9, tol = 1e-6, softening = 0.0, residual_tol = 1e-3;
   int max_iter = 999;
   app.add_option("case", path,
                  "CASE.json: {\"external_field\": [Hx,Hy,Hz], \"moments\": [...], \"magnetics\": {...}} "
@@ -128,8 +180,14 @@ int run(int argc, char** argv) {
   app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration")
       ->capture_default_str();
   app.add_option("--max-iter", max_iter, "iteration cap")->capture_default_str();
-  app.add_option("--softening", softening, "softening length ε in metres (0 = off)")
+  app.add_option("--softening", softening,
+                 "softening length ε in metres (0 = off; needed for two moments closer than half "
+                 "the sum of their radii, a = the radius of a sphere of the moment's volume)")
       ->capture_default_str();
+  app.add_option("--residual-tol", residual_tol,
+                 "\"converged\" needs the iteration to stop (--tol) and every induced moment's "
+                 "|M - f(H)| <= this x max(|M|, |f(H)|)")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
   app.footer(magsim::tools::exit_codes_footer(
@@ -138,6 +196,10 @@ int run(int argc, char** argv) {
       "(N > 3153) magsolve refuses the case (exit 1)."));
   if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
 
+  if (!std::isfinite(residual_tol)) {
+    std::fprintf(stderr, "magsolve: --residual-tol: must be a finite number > 0\n");
+    return kBadInput;
+  }
   mag::DynamicsOptions opt;
   if (!mag::parse_method(method_name, &opt.method)) {
     std::fprintf(stderr, "magsolve: unknown method '%s' (%s)\n", method_name.c_str(),
@@ -167,7 +229,7 @@ int run(int argc, char** argv) {
       std::fprintf(stderr, "magsolve: %s\n", e.c_str());
       return kBadInput;
     }
-    set = parse_moments(r, doc, opt.field.softening);
+    set = parse_moments(r, doc);
     std::size_t induced = 0;
     for (std::size_t j = 0; j < set.size(); ++j) induced += set.kind[j] == mag::MomentKind::Induced;
     if (reference_bytes(induced) > kReferenceBytesMax) {
@@ -180,6 +242,7 @@ int run(int argc, char** argv) {
                     static_cast<std::size_t>(std::sqrt(kReferenceBytesMax / (3.0 * 9 * sizeof(double)))));
       throw InputError(msg);
     }
+    if (opt.field.softening == 0.0) check_separations(set);
   } catch (const InputError& e) {
     std::fprintf(stderr, "magsolve: %s: %s\n", path.c_str(), e.what());
     return kBadInput;
@@ -191,7 +254,21 @@ int run(int argc, char** argv) {
   // ground truth of the method's curve
   const mag::Curve curve = mag::curve_of(opt.method);
   mag::MomentSet gt = set;
-  const mag::ExactStats gts = mag::solve_exact(&gt, curve, opt.field);
+  // long solves say what they are doing: the Newton reference factors a dense 3N x 3N
+  // matrix per step (N = 3153: ~9 GB of arithmetic per step), on stderr
+  std::size_t n_induced = 0;
+  for (std::size_t j = 0; j < set.size(); ++j) n_induced += set.kind[j] == mag::MomentKind::Induced;
+  const bool progress = n_induced >= kProgressMoments;
+  const auto tr = std::chrono::steady_clock::now();
+  if (progress)
+    std::fprintf(stderr, "magsolve: Newton reference for %zu induced moments (dense %zux%zu, %.2f GiB)...\n",
+                 n_induced, 3 * n_induced, 3 * n_induced, reference_bytes(n_induced) / (1 << 30));
+  const mag::ExactStats gts = mag::solve_exact(
+      &gt, curve, opt.field, 1e-12, 60, [&](int step, double residual) {
+        if (!progress) return;
+        std::fprintf(stderr, "magsolve: Newton reference step %d, relative residual %.3g, %.1f s\n", step,
+                     residual, std::chrono::duration<double>(std::chrono::steady_clock::now() - tr).count());
+      });
 
   const auto t0 = std::chrono::steady_clock::now();
   int iterations = 0;
@@ -212,21 +289,58 @@ int run(int argc, char** argv) {
   mag::compute_forces(set, mag::ForceModel::Zeeman, curve, opt.field, &ws, &F, &tau, &Fc);
   const double eM = mag::magnetization_error(set, gt.M);
 
-  bool finite = true;
-  for (std::size_t j = 0; j < set.size(); ++j)
-    finite = finite && set.M[j].allFinite() && ws.H[j].allFinite() && F[j].allFinite() &&
-             Fc[j].allFinite();
-  if (!finite) {
-    std::fprintf(stderr, "magsolve: %s: the solution is not finite (moments too close? try "
-                         "--softening)\n", path.c_str());
+  // nothing non-finite is printed (JSON would show null) or passes as success: name the first
+  // moment and quantity that is not finite
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    const char* what = !set.M[j].allFinite()  ? "magnetization M"
+                       : !ws.H[j].allFinite() ? "field H"
+                       : !F[j].allFinite()    ? "force F"
+                       : !Fc[j].allFinite()   ? "classic force F_classic"
+                       : !tau[j].allFinite()  ? "torque"
+                                              : nullptr;
+    if (what) {
+      std::fprintf(stderr, "magsolve: %s: the %s of moments[%zu] is not finite (the moments too close "
+                           "or too strong? try --softening); nothing printed\n", path.c_str(), what, j);
+      return kRunFailed;
+    }
+  }
+  if (!std::isfinite(eM)) {
+    std::fprintf(stderr, "magsolve: %s: e_M against the Newton reference is not finite (the reference "
+                         "failed: residual %g); nothing printed\n", path.c_str(), gts.residual);
     return kRunFailed;
   }
+
+  // Honest convergence. The dynamics stop when M changes by less than --tol x Ms in one
+  // iteration; in a weak field (|H| << Ms) that happens long before M reaches f(H) (a 1 A/m
+  // field: M = 2.16 A/m, "converged" after 4 iterations, e_M = 0.30). So "converged" also
+  // asks the fixed point itself: every induced moment's |M − f(H)| at most
+  // --residual-tol x max(|M|, |f(H)|) — M along H and at the curve's magnitude.
+  double residual = 0.0;
+  std::size_t worst = 0;
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    if (set.kind[j] != mag::MomentKind::Induced) continue;
+    const Vec3 f = mag::curve_M(curve, ws.H[j], set.Ms[j]);
+    const double scale = std::max(f.norm(), set.M[j].norm());
+    const double r = scale > 0 ? (set.M[j] - f).norm() / scale : 0.0;
+    if (r > residual) {
+      residual = r;
+      worst = j;
+    }
+  }
+  const bool stopped = converged;  // the iteration's own criterion was met
+  converged = stopped && residual <= residual_tol;
+  if (stopped && !converged)
+    std::fprintf(stderr, "magsolve: note: the iteration stopped (change below --tol) but M is not yet "
+                         "f(H): relative residual %.3g at moments[%zu] > --residual-tol %g; "
+                         "\"converged\": false\n", residual, worst, residual_tol);
 
   if (format == "json") {
     json out;
     out["method"] = mag::method_name(opt.method);
     out["iterations"] = iterations;
     out["converged"] = converged;
+    out["criterion_met"] = stopped;
+    out["residual"] = {{"max", residual}, {"moment", worst}, {"tol", residual_tol}};
     out["e_M"] = eM;
     out["wall_ms"] = wall_ms;
     out["ground_truth"] = {{"curve", curve == mag::Curve::Tanh ? "tanh (eq. 10)" : "kim (eq. 7)"},
@@ -246,8 +360,9 @@ int run(int argc, char** argv) {
     }
     std::cout << out.dump(2) << "\n";
   } else {
-    std::printf("# method=%s iterations=%d converged=%s e_M=%.6e\n", mag::method_name(opt.method),
-                iterations, converged ? "true" : "false", eM);
+    std::printf("# method=%s iterations=%d converged=%s criterion_met=%s residual=%.6e e_M=%.6e\n",
+                mag::method_name(opt.method), iterations, converged ? "true" : "false",
+                stopped ? "true" : "false", residual, eM);
     std::printf("index,kind,Mx,My,Mz,Hx,Hy,Hz,Fx,Fy,Fz,Fcx,Fcy,Fcz\n");
     for (std::size_t j = 0; j < set.size(); ++j) {
       const Vec3 &M = set.M[j], &H = ws.H[j];

@@ -24,16 +24,17 @@ std::string csv_field(const std::string& v) {
   return q + "\"";
 }
 
+// Any failure here is an I/O error (exit 3).
 void prepare_out_dir(const std::string& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw UsageError("--out " + dir + ": exists and is not a directory");
+    throw IoError("--out " + dir + ": exists and is not a directory");
   fs::create_directories(dir, ec);
-  if (ec) throw UsageError("--out " + dir + ": cannot create the directory (" + ec.message() + ")");
+  if (ec) throw IoError("--out " + dir + ": cannot create the directory (" + ec.message() + ")");
   const fs::path probe = fs::path(dir) / ".magsim_write_test";
   {
     std::ofstream f(probe);
-    if (!f || !(f << "ok") || !f.flush()) throw UsageError("--out " + dir + ": directory is not writable");
+    if (!f || !(f << "ok") || !f.flush()) throw IoError("--out " + dir + ": directory is not writable");
   }
   fs::remove(probe, ec);
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {

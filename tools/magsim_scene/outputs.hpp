@@ -114,6 +114,7 @@ class Recorder {
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
     series_["substeps"].push_back(sim_.last_profile().substeps);
+    series_["threads"].push_back(sim_.threads());
     check();
     // the energy audit (engine/energy.hpp): state functions and cumulative work (J), and the
     // last step's magnetic and contact work (J per step)

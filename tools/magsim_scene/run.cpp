@@ -10,6 +10,7 @@
 // Exit codes (the same in magsolve): 0 done, 1 bad usage, flags or scene, 2 the simulation
 // failed (SimulationError; summary.json holds the error and the last good state), 3 I/O
 // error (an output file could not be written).
+#include "engine/cpu_share.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/scene_file.hpp"
 #include "tools/magsim_scene/outputs.hpp"
@@ -19,10 +20,12 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace magsim::scene_tool {
@@ -49,6 +52,11 @@ double sum(const std::vector<double>& v) {
 }  // namespace
 
 int run(const Args& a, const CLI::App& app) {
+  // busy machines (cpu_share.hpp): unless the user fixed the thread count (--threads, the scene
+  // file's options.threads or OMP_NUM_THREADS), the magnetics use as many threads as the other
+  // processes leave cores free; the first window of the estimate is the scene's set-up
+  const unsigned cores = std::thread::hardware_concurrency();
+  engine::ThreadGovernor governor(cores > 0 ? static_cast<int>(cores) : 1);  // Simulation caps it at its own count
   engine::SceneDesc scene = resolve_scene(a, app);
   const std::string method = mag::method_name(scene.options.method);
   std::unique_ptr<engine::Simulation> sim_ptr;
@@ -59,6 +67,7 @@ int run(const Args& a, const CLI::App& app) {
   }
   engine::Simulation& sim = *sim_ptr;
   const engine::Model& model = sim.model();
+  const bool adaptive = scene.options.threads == 0 && std::getenv("OMP_NUM_THREADS") == nullptr;
   const double dt = model.options.dt;
 
   // the run's length, checked in double before any conversion to long
@@ -92,7 +101,7 @@ int run(const Args& a, const CLI::App& app) {
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
-  std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters;
+  std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters, threads;
   Ti.reserve(n_steps);
   Tf.reserve(n_steps);
   Tr.reserve(n_steps);
@@ -100,6 +109,7 @@ int run(const Args& a, const CLI::App& app) {
   quickstep.reserve(n_steps);
   total.reserve(n_steps);
   iters.reserve(n_steps);
+  threads.reserve(n_steps);
   long cap_hits = 0;
   std::vector<double> substeps;  // rigid sub-steps per frame
   substeps.reserve(n_steps);
@@ -112,6 +122,8 @@ int run(const Args& a, const CLI::App& app) {
   try {
     if (rec.frame()) painter.draw(sim);
     for (long k = 0; k < n_steps; ++k) {
+      if (adaptive) sim.limit_default_threads(governor.threads());
+      threads.push_back(sim.threads());
       try {
         sim.step();
       } catch (const engine::SimulationError& e) {
@@ -134,10 +146,10 @@ int run(const Args& a, const CLI::App& app) {
         last_report = now;
         std::fprintf(stderr,
                      "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
-                     "iterations %d%s\n",
+                     "iterations %d%s  threads %d\n",
                      scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
                      std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
-                     p.cap_hit ? " (cap)" : "");
+                     p.cap_hit ? " (cap)" : "", sim.threads());
       }
     }
     if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
@@ -194,6 +206,14 @@ int run(const Args& a, const CLI::App& app) {
         {"collide", stats(collide)},
         {"quickstep", stats(quickstep)},
         {"step", stats(total)}}},
+      // OpenMP threads of the magnetics per step: adaptive = chosen from the other processes'
+      // load (cpu_share.hpp), else the fixed count of --threads / options.threads / OMP_NUM_THREADS
+      {"threads",
+       {{"adaptive", adaptive},
+        {"median", median(threads)},
+        {"min", threads.empty() ? 0.0 : *std::min_element(threads.begin(), threads.end())},
+        {"max", threads.empty() ? 0.0 : *std::max_element(threads.begin(), threads.end())},
+        {"others_load", governor.others()}}},
       {"iterations",
        {{"median", median(iters)},
         {"max", iters.empty() ? 0.0 : *std::max_element(iters.begin(), iters.end())},
