@@ -13,9 +13,10 @@ namespace magsim::engine {
 void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
   const mag::Method method = m.options.method;
   const ForceChoice fc = m.options.force_model;
-  const mag::ForceModel model = fc == ForceChoice::Zeeman    ? mag::ForceModel::Zeeman
-                                : fc == ForceChoice::Classic ? mag::ForceModel::Classic
-                                                             : mag::force_model_of(method);
+  const mag::ForceModel model = fc == ForceChoice::Zeeman        ? mag::ForceModel::Zeeman
+                                : fc == ForceChoice::Classic     ? mag::ForceModel::Classic
+                                : fc == ForceChoice::ZeemanTotal ? mag::ForceModel::ZeemanTotal
+                                                                 : mag::force_model_of(method);
   mag::compute_forces(set, model, mag::curve_of(method),
                       m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
                       m.options.reaction_symmetric_forces);

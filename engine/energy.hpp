@@ -66,7 +66,9 @@ struct EnergyAudit {
   double initial_gravitational = 0.0;  ///< U_g at the start of the audit (J)
   /// Interaction energy of the moments (J) from the last field evaluation (the force stage
   /// of the last step: poses before its rigid step, converged magnetizations), see
-  /// magnetic_energy(); 0 before the first step or when no field has been evaluated.
+  /// magnetic_energy(); 0 before the first step or when no field has been evaluated. With
+  /// the zeeman-total force model it is that force's potential E_sys (mag::
+  /// zeeman_total_energy), so W_mag ≈ −ΔU_mag up to the rigid step's integration error.
   double magnetic_energy = 0.0;
   EnergyFlow total;  ///< sums since the start of the audit
   EnergyFlow last;   ///< the last rigid step (the sum over its ODE sub-steps)

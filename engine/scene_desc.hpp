@@ -87,21 +87,27 @@ inline bool parse_space(const std::string& name, SpaceKind* out) {
 enum class ForceChoice {
   Method,   ///< the method's own pairing: classic for Kim 2018, Zeeman (eq. 4) otherwise
   Zeeman,   ///< eq. 4: F = μ0 V J [A (2M + H) + M]; 2(χ+1) ≈ 8× classic in the linear range
-  Classic   ///< eqs. 13–14: F = μ0 J m, m held constant
+  Classic,  ///< eqs. 13–14: F = μ0 J m, m held constant
+  /// eq. 4 as the gradient of the system's Zeeman energy, every magnetization a variable
+  /// (mag::compute_forces): conservative and momentum-conserving; reaction_symmetric_forces
+  /// has no effect on it
+  ZeemanTotal
 };
 
-/// "method", "zeeman", "classic" (scene files, --force-model, summary.json).
+/// "method", "zeeman", "classic", "zeeman-total" (scene files, --force-model, summary.json).
 inline const char* force_choice_name(ForceChoice f) {
   switch (f) {
     case ForceChoice::Method: return "method";
     case ForceChoice::Zeeman: return "zeeman";
     case ForceChoice::Classic: return "classic";
+    case ForceChoice::ZeemanTotal: return "zeeman-total";
   }
   return "?";
 }
 /// Parses a force model name; returns false (and leaves *out alone) on an unknown name.
 inline bool parse_force_choice(const std::string& name, ForceChoice* out) {
-  for (ForceChoice f : {ForceChoice::Method, ForceChoice::Zeeman, ForceChoice::Classic})
+  for (ForceChoice f : {ForceChoice::Method, ForceChoice::Zeeman, ForceChoice::Classic,
+                        ForceChoice::ZeemanTotal})
     if (name == force_choice_name(f)) {
       *out = f;
       return true;

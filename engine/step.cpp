@@ -15,6 +15,7 @@
 
 #include "engine/ode_bridge.hpp"
 #include "engine/stages.hpp"
+#include "magnetics/forces.hpp"
 
 #include <omp.h>
 #include <utility>
@@ -129,7 +130,12 @@ void Simulation::step() {
       // energy audit: the work of the last ODE step (O(bodies)); U_mag from the forces' field
       audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque, h,
                     &ws_.audit);
-      ws_.audit.magnetic_energy = magnetic_energy(moments_, ws_.mag.H);
+      // the potential of the force where it has one (zeeman-total: E_sys, forces.hpp)
+      ws_.audit.magnetic_energy =
+          m.options.force_model == ForceChoice::ZeemanTotal && ws_.mag.H.size() == moments_.size()
+              ? mag::zeeman_total_energy(moments_, mag::curve_of(m.options.method), ws_.mag.H,
+                                         ws_.mag.total.perm, ws_.mag.total.Hp)
+              : magnetic_energy(moments_, ws_.mag.H);
       std::swap(energy_, ws_.audit);
       std::swap(state_, next);
       place_moments(m, state_, &moments_);  // moments() follows the new poses

@@ -3,6 +3,7 @@
 #include "magnetics/forces.hpp"
 
 #include "magnetics/curves.hpp"
+#include "magnetics/forces_total.hpp"
 
 namespace magsim::mag {
 
@@ -24,8 +25,12 @@ Vec3 classic_force(const Vec3& m, const Mat3& J) { return kMu0 * (J * m); }
 void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
                     const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
                     std::vector<Vec3>* tau, std::vector<Vec3>* F_classic,
-                    bool reaction_symmetric) {
+                    bool reaction_symmetric, double total_tol, int total_max_iter) {
   compute_fields(set, field, &ws->H, &ws->J, &ws->field);
+  if (model == ForceModel::ZeemanTotal) {
+    detail::zeeman_total_forces(set, curve, field, ws, F, tau, F_classic, total_tol, total_max_iter);
+    return;
+  }
   const long n = static_cast<long>(set.size());
   F->resize(n);
   if (tau) tau->resize(n);

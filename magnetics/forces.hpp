@@ -33,9 +33,43 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// (induced moments: none, M does not turn with its body). Angular momentum is then
 /// conserved up to the torques the pair energy would put on induced moments,
 /// ½ μ0 Σ m_j × H̃_j over induced j (a test measures it).
+///
+/// ForceModel::ZeemanTotal — eq. 4 taken over the whole system ("magnetic moments and
+/// equivalently magnetizations are taken as variables", §6.1): the forces are the exact
+/// negative gradient of
+///   E_sys = Σ_{i induced} e_i(H_i) + U_pp,   e_i = −μ0 V_i f(H_i)·(f(H_i) + H_i)  (eqs. 3–4),
+///   U_pp = −μ0 [½ Σ_p m_p·H^perm_p + Σ_p m_p·H0]   (permanent pairs, the physical energy),
+/// with every induced M_j = f(H_j) at equilibrium, so a change of one position moves every
+/// magnetization. eq. 4's per-moment force is the part of this gradient where the sources
+/// stay fixed; what it leaves out (the neighbours' energies and magnetizations) makes it
+/// non-conservative in a pile: measured in falling_magnet, eq. 4 does 2.7× the work of the
+/// energy it releases (issue #12). The gradient, by the adjoint method:
+///   m̃_i = V_i [A_i (2M_i + H_i) + M_i]                       (−∂e_i/∂H_i / μ0)
+///   λ̃ = m̃ + V A T λ̃   (T: the dipole field of moments at induced moments, eq. 1)
+///   F_k = μ0 [J_kᵀ λ̃_k + J̃_kᵀ m_k]          (k induced; J̃ = ∂H̃/∂p, H̃ the field of λ̃)
+///   F_p = μ0 (J̃_p + J^perm_p)ᵀ m_p,  τ_p = μ0 m_p × (H̃_p + H^perm_p)   (p permanent)
+/// For one induced moment in a fixed field λ̃ = m̃ and F is eq. 4 exactly. Σ F = 0 (E_sys
+/// is translation invariant). The adjoint system is solved symmetrically, with
+/// B = (V A)^{1/2} and λ̃ = m̃ + B w: (I − B T B) w = B T m̃ by conjugate gradients
+/// (I − B T B is positive definite where the magnetization equilibrium is stable),
+/// warm-started from the last call, to |residual| ≤ total_tol |right side|; each CG
+/// iteration is one field evaluation. Statistics in ws->total. reaction_symmetric is
+/// ignored (momentum is conserved already). Same-body pairs (one group) add no force, as for
+/// the other models.
 void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
                     const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
                     std::vector<Vec3>* tau, std::vector<Vec3>* F_classic = nullptr,
-                    bool reaction_symmetric = false);
+                    bool reaction_symmetric = false, double total_tol = 1e-4,
+                    int total_max_iter = 100);
+
+/// E_sys of ForceModel::ZeemanTotal at the magnetizations in `set` (the equilibrium ones:
+/// the force is its gradient there). J.
+double zeeman_total_energy(const MomentSet& set, Curve curve, const FieldOptions& field,
+                           FieldWorkspace* ws);
+/// The same from fields already evaluated: H at every moment, Hp the permanent moments' own
+/// field (with H0) at the permanent moments perm (ws->total.perm and .Hp after a
+/// ZeemanTotal force evaluation).
+double zeeman_total_energy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H,
+                           const std::vector<int>& perm, const std::vector<Vec3>& Hp);
 
 }  // namespace magsim::mag

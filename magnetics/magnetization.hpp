@@ -68,6 +68,23 @@ struct AndersonHistory {
   double beta = 1.0;                    ///< current damping
 };
 
+/// Scratch and statistics of ForceModel::ZeemanTotal (forces.hpp). Reused across steps; w
+/// warm-starts the next adjoint solve.
+struct ZeemanTotalScratch {
+  std::vector<int> idx;            ///< (k) induced moment indices
+  std::vector<Mat3> B;             ///< (k) (V A)^{1/2}
+  std::vector<Vec3> mt, c, w, r, p, q, z;  ///< (k) m̃, right side, iterate, CG vectors
+  std::vector<int> perm;           ///< permanent moment indices
+  std::vector<Vec3> Hp;            ///< field of the permanent moments (and H0) at them
+  std::vector<Mat3> Jp;            ///< its Jacobian
+  MomentSet src;                   ///< scratch: the adjoint moments as sources
+  std::vector<Vec3> Hs;            ///< (n) field of src
+  std::vector<Mat3> Js;            ///< (n) its Jacobian
+  int iterations = 0;              ///< CG iterations of the last solve
+  double residual = 0.0;           ///< its relative residual |c − S w| / |c|
+  bool converged = true;           ///< residual ≤ tolerance
+};
+
 /// Scratch of a solve: fields, Jacobians and the packed sources. Reused across steps.
 struct MagWorkspace {
   FieldWorkspace field;
@@ -78,6 +95,7 @@ struct MagWorkspace {
   std::vector<Mat3> J_eff_src;  ///< (n) its Jacobian (scratch)
   std::vector<Mat3> A;  ///< (n) scratch for the Newton solver
   AndersonHistory anderson;  ///< Method::Anderson only
+  ZeemanTotalScratch total;  ///< ForceModel::ZeemanTotal only
 };
 
 struct RelaxStats {

@@ -30,8 +30,11 @@ enum class Curve : std::uint8_t {
 
 /// Force model for induced moments.
 enum class ForceModel : std::uint8_t {
-  Zeeman,  ///< ours, eq. 4 (M varies with H)
-  Classic  ///< eqs. 13–14 (m held constant)
+  Zeeman,  ///< ours, eq. 4 (M varies with H), each moment's gradient with the sources fixed
+  Classic,  ///< eqs. 13–14 (m held constant)
+  /// eq. 4 as the gradient of the system's Zeeman energy with every magnetization a variable
+  /// (forces.hpp, compute_forces): conservative, momentum-conserving
+  ZeemanTotal
 };
 
 /// The curve a method converges to (Kim 2018 uses eq. 7, every other method eq. 10).

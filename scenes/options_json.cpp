@@ -174,7 +174,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = r.integer(v, p, 0, 1024); });
   if_present(j, "force_model", path, [&](const json& v, const std::string& p) {
     const std::string s = r.string(v, p);
-    if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic)");
+    if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic, zeeman-total)");
   });
   if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = r.integer(v, p, 1, 64); });
   if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.positive(v, p); });

@@ -20,7 +20,8 @@
 //       "linear_damping": 0, "angular_damping": 0, "surface_layer": 0,
 //       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
 //       "reaction_symmetric_forces": false,
-//       "force_model": "method" | "zeeman" | "classic", "max_substeps": 1,
+//       "force_model": "method" | "zeeman" | "classic" | "zeeman-total",
+//       "max_substeps": 1,
 //       "substep_reach": 0.25, "rolling_friction": 0, "quickstep_w": 1.3,
 //       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]
 //       "bh_threshold": 2000,                   // auto: Barnes–Hut from this many moments

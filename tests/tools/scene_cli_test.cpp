@@ -62,6 +62,19 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
     CHECK(j["series"][k].size() == j["series"]["time"].size());
 }
 
+TEST_CASE("magsim-scene: --force-model zeeman-total and --softening reach the run", "[tools]") {
+  const std::string out = tmp_dir("total");
+  const Result r = run_scene("balls_up --steps 3 --no-render --count 20 --force-model zeeman-total "
+                             "--softening 0.002 --out " + out);
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::ifstream f(out + "/summary.json");
+  REQUIRE(f.good());
+  const auto j = nlohmann::json::parse(f);
+  CHECK(j["options"]["force_model"] == "zeeman-total");
+  CHECK(j["options"]["magnetics"]["softening"] == 0.002);
+}
+
 TEST_CASE("magsim-scene: the default broad phase is sweep and prune", "[tools]") {
   const std::string out = tmp_dir("default");
   const Result r = run_scene("balls_up --steps 1 --no-render --count 20 --out " + out);
@@ -81,6 +94,9 @@ TEST_CASE("magsim-scene refuses bad ODE flags with a message and exit code 1", "
       {"balls_up --steps 1 --no-render --space octree", "--space"},
       {"balls_up --steps 1 --no-render --quickstep-iterations 0", "--quickstep-iterations"},
       {"balls_up --steps 1 --no-render --quickstep-iterations many", "--quickstep-iterations"},
+      {"balls_up --steps 1 --no-render --softening -0.001", "--softening"},
+      {"balls_up --steps 1 --no-render --softening 1", "--softening"},
+      {"balls_up --steps 1 --no-render --force-model total", "--force-model"},
   };
   for (const Case& c : cases) {
     const Result r = run_scene(c.args);

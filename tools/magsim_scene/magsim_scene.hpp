@@ -65,6 +65,7 @@ struct Args {
   double quickstep_w = 0.0;
   double dt = 0.0;
   std::string bounded_pairs;
+  double softening = -1.0;
   tools::FieldFlags field;
   bool list = false;
   std::string write_scene;

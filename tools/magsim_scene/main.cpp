@@ -78,7 +78,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
   if (app.count("--auto-disable")) s.options.auto_disable = true;
   if (app.count("--force-model") && !engine::parse_force_choice(a.force_model, &s.options.force_model))
-    throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman or classic)");
+    throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman, classic or zeeman-total)");
   if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
   if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
@@ -89,6 +89,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
       throw UsageError("--bounded-pairs: expected on or off, got '" + a.bounded_pairs + "'");
     s.options.magnetics.field.bounded_pairs = a.bounded_pairs == "on";
   }
+  if (app.count("--softening")) s.options.magnetics.field.softening = a.softening;
   if (app.count("--space")) {
     if (!engine::parse_space(a.space, &s.options.space))
       throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
@@ -170,7 +171,8 @@ int main(int argc, char** argv) {
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   app.add_option("--force-model", a.force_model,
                  "force on induced moments: method (the method's own: classic for kim2018, eq. 4 "
-                 "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) (default: the scene's, method)");
+                 "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) | zeeman-total (eq. 4 as the gradient "
+                 "of the system's Zeeman energy: conservative) (default: the scene's, method)");
   app.add_option("--max-substeps", a.max_substeps,
                  "most rigid sub-steps per frame; a frame is split when bodies move fast (1 = never; default: the scene's)")
       ->check(CLI::Range(1, 64));
@@ -186,6 +188,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-7, 0.1));
   app.add_option("--bounded-pairs", a.bounded_pairs,
                  "on | off: evaluate a pair of moments no closer than the sum of their interaction radii (default: the scene's, off)");
+  app.add_option("--softening", a.softening,
+                 "dipole softening length eps (m): |r|^2 -> |r|^2 + eps^2 in every field, Jacobian and "
+                 "force, in [0, 0.1] (default: the scene's)")
+      ->check(CLI::Range(0.0, 0.1));
   a.field.add(&app,
               "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
