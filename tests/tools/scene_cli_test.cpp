@@ -153,3 +153,39 @@ TEST_CASE("magsim-scene NAME --write-scene FILE: the file runs to the registry r
   CHECK(ja["options"] == jb["options"]);
   std::remove(file.c_str());
 }
+
+TEST_CASE("tools/ensemble.py: one row per perturbed run, each from its summary.json, and the spread", "[tools]") {
+  const std::string out = tmp_dir("ensemble");
+  const std::string py = std::string("MAGSIM_SCENE_BIN=") + MAGSIM_SCENE_BIN + " /usr/bin/python3";
+  const Result r = magsim::test::run_command(
+      py, std::string(MAGSIM_SOURCE_DIR) + "/tools/ensemble.py balls_up --runs 2 --seconds 0.02 --base-count 20 --out " +
+              out + " -- --threads 1");
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  std::ifstream f(out + "/ensemble.json");
+  REQUIRE(f.good());
+  const auto j = nlohmann::json::parse(f);
+  REQUIRE(j["runs"].size() == 2);
+  double sum = 0;
+  for (int k = 0; k < 2; ++k) {
+    const auto& row = j["runs"][k];
+    CHECK(row["count"] == 20 - k);
+    std::ifstream sf(out + "/run_" + std::to_string(20 - k) + "/summary.json");
+    REQUIRE(sf.good());
+    const auto s = nlohmann::json::parse(sf);
+    CHECK(s["dynamic_bodies"] == 20 - k);  // one ball fewer each run
+    CHECK(row["escaped"] == s["final"]["escaped"]);
+    CHECK(row["held"] == s["final"]["held"]);
+    CHECK(row["max_speed_end"].get<double>() == s["final"]["max_speed"].get<double>());
+    sum += row["escaped"].get<double>();
+  }
+  CHECK(j["stats"]["escaped"]["mean"].get<double>() == Approx(sum / 2));
+  CHECK(j["failed"] == 0);
+  // bad usage: exit 2 and a one-line reason
+  for (const char* bad : {"balls_up --runs 0", "balls_up --seconds -1", "nosuch_scene", "balls_up --frobnicate"}) {
+    const Result b = magsim::test::run_command(py, std::string(MAGSIM_SOURCE_DIR) + "/tools/ensemble.py " + bad);
+    INFO(bad << ": " << b.out);
+    CHECK(b.code == 2);
+    CHECK(b.out.find("ensemble.py:") != std::string::npos);
+  }
+}

@@ -1,0 +1,164 @@
+#!/usr/bin/python3
+"""tools/ensemble.py — one scene, several perturbed runs: the spread of its outcome.
+
+A single run of a strongly magnetized pile is chaotic: removing one ball of 1032 moves the
+number of balls that fly off falling_magnet between 10 and 25 (issue #12). This runs the
+scene N times with --count BASE, BASE-1, ..., BASE-N+1 (one body fewer each time) and
+reports per run and over the runs: escaped (beyond the scene's escape_radius, summary.json
+"final"), held, the fastest body at the end and in the last second, and the error if the
+run failed.
+
+usage: /usr/bin/python3 tools/ensemble.py SCENE [--runs N] [--seconds S] [--base-count C]
+                                          [--out DIR] [--label L] [-- MAGSIM_SCENE_FLAGS...]
+  SCENE          a registry scene (balls_up, alphabets, falling_magnet, sakura_tree)
+  --runs N       runs (default 6), N >= 1
+  --seconds S    simulated seconds per run (default: 0.6)
+  --base-count C the count of the first run (default: the scene's own count)
+  --out DIR      output directory (default out/ensemble/SCENE[_L])
+  --label L      a name for this configuration, in the output and DIR
+  flags after -- go to every magsim-scene run (e.g. -- --force-model classic --threads 1)
+The program run is build/release/tools/magsim-scene, or $MAGSIM_SCENE_BIN when set.
+Writes DIR/run_<count>/ (each run's summary.json, states.csv), DIR/ensemble.csv (a row per
+run) and DIR/ensemble.json (the rows and min/median/mean/max of each figure). Exit 0 when
+every run finished, 1 when a run failed (its row says why), 2 on bad usage.
+"""
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+
+DEFAULT_COUNT = {"balls_up": 243, "alphabets": 100, "falling_magnet": 1032, "sakura_tree": 2500}
+FIGURES = ["escaped", "held", "max_speed_end", "max_speed_last_second"]
+
+
+def usage_error(msg):
+    print(f"ensemble.py: {msg} (try --help)", file=sys.stderr)
+    sys.exit(2)
+
+
+def parse(argv):
+    if "-h" in argv[:1] or "--help" in argv[:1]:
+        print(__doc__.strip())
+        sys.exit(0)
+    extra = []
+    if "--" in argv:
+        i = argv.index("--")
+        argv, extra = argv[:i], argv[i + 1:]
+    opts = {"runs": 6, "seconds": 0.6, "base_count": None, "out": None, "label": None}
+    pos = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("--runs", "--seconds", "--base-count", "--out", "--label"):
+            if i + 1 >= len(argv):
+                usage_error(f"{a} needs a value")
+            v = argv[i + 1]
+            key = a[2:].replace("-", "_")
+            try:
+                if key in ("runs", "base_count"):
+                    opts[key] = int(v)
+                elif key == "seconds":
+                    opts[key] = float(v)
+                else:
+                    opts[key] = v
+            except ValueError:
+                usage_error(f"{a}: not a number: '{v}'")
+            i += 2
+        elif a.startswith("-"):
+            usage_error(f"unknown option '{a}'")
+        else:
+            pos.append(a)
+            i += 1
+    if len(pos) != 1:
+        usage_error("expected one scene name")
+    scene = pos[0]
+    if opts["base_count"] is None:
+        if scene not in DEFAULT_COUNT:
+            usage_error(f"no default count for '{scene}': give --base-count")
+        opts["base_count"] = DEFAULT_COUNT[scene]
+    if opts["runs"] < 1 or opts["base_count"] - opts["runs"] + 1 < 1:
+        usage_error("--runs must be >= 1 and leave every run at least one body")
+    if not (opts["seconds"] > 0 and math.isfinite(opts["seconds"])):
+        usage_error("--seconds must be positive")
+    if opts["out"] is None:
+        opts["out"] = os.path.join("out", "ensemble", scene + (f"_{opts['label']}" if opts["label"] else ""))
+    return scene, opts, extra
+
+
+def row_of(count, summary_path, rc, log):
+    row = {"count": count, "exit": rc, "error": None}
+    try:
+        s = json.load(open(summary_path))
+    except (OSError, ValueError) as e:
+        row["error"] = f"no summary.json ({e}); {log.strip().splitlines()[-1] if log.strip() else ''}"
+        for f in FIGURES:
+            row[f] = None
+        return row
+    fin = s["final"]
+    ser = s["series"]
+    t_end = ser["time"][-1] if ser["time"] else 0.0
+    last = [v for t, v in zip(ser["time"], ser["max_speed"]) if t >= t_end - 1.0 and v is not None]
+    row.update({
+        "escaped": fin.get("escaped"),
+        "held": fin.get("held"),
+        "max_speed_end": fin.get("max_speed"),
+        "max_speed_last_second": max(last) if last else None,
+        "error": s.get("error"),
+    })
+    return row
+
+
+def stats(values):
+    v = [x for x in values if x is not None]
+    if not v:
+        return None
+    return {"min": min(v), "median": statistics.median(v), "mean": statistics.fmean(v), "max": max(v)}
+
+
+def main():
+    scene, opts, extra = parse(sys.argv[1:])
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    binary = os.environ.get("MAGSIM_SCENE_BIN") or os.path.join(root, "build", "release", "tools", "magsim-scene")
+    if not os.access(binary, os.X_OK):
+        print(f"ensemble.py: {binary} not built (run tools/setup.sh --no-demo)", file=sys.stderr)
+        return 1
+    os.makedirs(opts["out"], exist_ok=True)
+    rows = []
+    for k in range(opts["runs"]):
+        count = opts["base_count"] - k
+        d = os.path.join(opts["out"], f"run_{count}")
+        cmd = [binary, scene, "--count", str(count), "--seconds", str(opts["seconds"]),
+               "--no-render", "--out", d] + extra
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if p.returncode == 1:  # bad usage or scene: every run would fail the same way
+            print(f"ensemble.py: magsim-scene refused the run:\n{p.stdout.strip()}", file=sys.stderr)
+            return 2
+        r = row_of(count, os.path.join(d, "summary.json"), p.returncode, p.stdout)
+        rows.append(r)
+        print(f"run {k + 1}/{opts['runs']} (count {count}): escaped {r['escaped']}, held {r['held']}, "
+              f"fastest at the end {r['max_speed_end']} m/s, in the last second "
+              f"{r['max_speed_last_second']} m/s" + (f", error: {r['error']}" if r["error"] else ""),
+              flush=True)
+    with open(os.path.join(opts["out"], "ensemble.csv"), "w") as f:
+        cols = ["count", "exit"] + FIGURES + ["error"]
+        f.write(",".join(cols) + "\n")
+        for r in rows:
+            f.write(",".join("" if r[c] is None else json.dumps(r[c]) if c == "error" else str(r[c])
+                             for c in cols) + "\n")
+    summary = {"scene": scene, "label": opts["label"], "seconds": opts["seconds"], "runs": rows,
+               "flags": extra, "stats": {f: stats([r[f] for r in rows]) for f in FIGURES},
+               "failed": sum(1 for r in rows if r["error"] or r["exit"] != 0)}
+    with open(os.path.join(opts["out"], "ensemble.json"), "w") as f:
+        json.dump(summary, f, indent=1)
+    e = summary["stats"]["escaped"]
+    if e:
+        print(f"{scene}{' ' + opts['label'] if opts['label'] else ''}: escaped per run "
+              f"{[r['escaped'] for r in rows]}, mean {e['mean']:.1f}, median {e['median']}, "
+              f"range {e['min']}-{e['max']}; {summary['failed']} failed; {opts['out']}/ensemble.json")
+    return 1 if summary["failed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
