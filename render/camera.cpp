@@ -104,6 +104,12 @@ ViewSetup view_setup(const Frame& frame, float aspect) {
   v.z_near = cam.z_near > 0.0f ? cam.z_near : z_near;
   v.z_far = cam.z_far > 0.0f ? cam.z_far : z_far;
 
+  const float cam_dist = std::max((cam.eye - cam.target).norm(), 1e-3f);
+  v.ground_cell = 0.5f * std::pow(10.0f, std::floor(std::log10(cam_dist)));
+  v.fade_start = 1.05f * cam_dist;
+  v.fade_end = 2.7f * cam_dist;
+  v.fade_center = cam.target;
+
   v.view = look_at(cam.eye, cam.target, cam.up);
   v.proj = perspective(cam.fov_y_deg, aspect, v.z_near, v.z_far);
   v.view_proj = v.proj * v.view;

@@ -38,6 +38,13 @@ struct ViewSetup {
   Eigen::Vector3f scene_center = Eigen::Vector3f::Zero();  ///< (m)
   float scene_radius = 0.1f;                                ///< (m)
   float ground_extent = 1.0f;  ///< half side of the ground quad around scene_center (m)
+  /// Ground grid cell and fade (m), from the camera alone (eye–target distance d): cell
+  /// 0.5 × 10^⌊log10 d⌋, fading out between 1.05 d and 2.7 d from the target. Not from the
+  /// scene's extent, which grows when a body flies off: the floor kept its look through a
+  /// video and between two runs shown side by side only by chance.
+  float ground_cell = 0.05f;
+  float fade_start = 1.0f, fade_end = 2.0f;
+  Eigen::Vector3f fade_center = Eigen::Vector3f::Zero();  ///< the camera target (m)
 };
 
 /// Camera matrices for an image of aspect width/height; near/far from the scene's extent

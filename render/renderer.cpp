@@ -765,9 +765,8 @@ void Renderer::Impl::draw(const Frame& frame) {
   lap(profile.sphere_depth);
   if (frame.ground) {
     glBindVertexArray(ground_vao);
-    // grid cell: half the power of ten just below the scene's diameter (5 cm for a
-    // 10–99 cm scene), so a few cells span the scene
-    const float cell = 0.5f * std::pow(10.0f, std::floor(std::log10(2.0f * view.scene_radius)));
+    // grid cell and fade: from the camera (view_setup), the same in every frame of a run
+    const float cell = view.ground_cell;
     for (int part = 0; part < 2; ++part) {
       const GLsizei first = part == 0 ? 0 : ground_inner;
       const GLsizei count = part == 0 ? ground_inner : ground_outer;
@@ -777,9 +776,9 @@ void Renderer::Impl::draw(const Frame& frame) {
       glUniform1f(loc(p, "u_ground_height"), frame.ground_height);
       set_vec3(p, "u_ground_color", frame.ground_color);
       glUniform3f(loc(p, "u_background_srgb"), clear[0], clear[1], clear[2]);
-      glUniform3f(loc(p, "u_ground_center"), gx, gy, frame.ground_height);
+      glUniform3f(loc(p, "u_ground_center"), view.fade_center.x(), view.fade_center.y(), frame.ground_height);
       glUniform1f(loc(p, "u_grid"), cell);
-      glUniform2f(loc(p, "u_fade"), 0.35f * G, 0.9f * G);
+      glUniform2f(loc(p, "u_fade"), view.fade_start, view.fade_end);
       glDrawArrays(GL_TRIANGLES, first, count);
     }
   }

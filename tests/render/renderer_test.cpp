@@ -355,3 +355,27 @@ TEST_CASE("output: FrameWriter writes every frame and reports errors", "[render]
                std::vector<std::uint8_t>(std::size_t(w) * h * 3, 0));
   CHECK_THROWS_AS(failing.finish(), std::runtime_error);
 }
+
+TEST_CASE("renderer: the floor's grid and fade do not change when a body flies far away", "[render]") {
+  // the same camera, once with a second sphere 20 m off: the scene's extent grows 100×, the
+  // floor in front of the camera must look the same (it used to take its grid cell from the
+  // extent: a ball thrown off made the floor jump from 5 cm to 5 m cells mid-video)
+  Renderer a(320, 240), b(320, 240);
+  Frame f = red_ball_frame();
+  a.draw(f);
+  Shape far = f.shapes[0];
+  far.position = Eigen::Vector3f(20.0f, 20.0f, 0.1f);
+  f.shapes.push_back(far);
+  b.draw(f);
+  // the bottom 60 rows: ground between the camera and the ball, away from its shadow
+  int differ = 0, lines = 0;
+  for (int y = 180; y < 240; ++y)
+    for (int x = 0; x < 320; ++x) {
+      const Rgb pa = pixel_at(a, x + 0.5f, y + 0.5f), pb = pixel_at(b, x + 0.5f, y + 0.5f);
+      differ += !near_colour(pa, pb, 3);
+      lines += pa.luminance() < pixel_at(a, 0.5f, 239.5f).luminance() - 8.0;
+    }
+  INFO(differ << " of 19200 pixels differ; " << lines << " darker (grid lines, checker)");
+  CHECK(differ == 0);
+  CHECK(lines > 100);  // the grid is drawn there: the comparison sees it
+}
