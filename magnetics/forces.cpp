@@ -10,7 +10,7 @@ namespace magsim::mag {
 // eq. 4 (order of products derived, see header): F = μ0 V J [A (2M + H) + M]
 Vec3 zeeman_force(Curve curve, double V, double Ms, const Vec3& M, const Vec3& H, const Mat3& J) {
   const Mat3 A = curve_dMdH(curve, H, Ms);
-  return kMu0 * V * (J * (A * (2.0 * M + H) + M));
+  return kMu0 * V * (J * zeeman_effective_magnetization(A, M, H));
 }
 
 // eqs. 3–4: E = −m·B = −μ0 V M·(M + H)
@@ -59,7 +59,7 @@ void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
   for (long j = 0; j < n; ++j) {
     if (set.kind[j] != MomentKind::Induced) continue;
     const Mat3 A = curve_dMdH(curve, ws->H[j], set.Ms[j]);
-    eff.M[j] = A * (2.0 * set.M[j] + ws->H[j]) + set.M[j];
+    eff.M[j] = zeeman_effective_magnetization(A, set.M[j], ws->H[j]);
   }
   compute_fields(eff, field, &ws->H_eff_src, &ws->J_eff_src, &ws->field);
   // F_j = ½ (F_zeeman,j + μ0 J̃_j m_j)

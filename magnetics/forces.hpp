@@ -11,6 +11,12 @@ namespace magsim::mag {
 /// The printed eq. 4 reads A J (2M + H); the chain rule gives J A (2M + H) — the two
 /// differ when A is anisotropic (near saturation). Proven by a finite-difference test.
 Vec3 zeeman_force(Curve curve, double V, double Ms, const Vec3& M, const Vec3& H, const Mat3& J);
+/// The magnetization in eq. 4's bracket, A (2M + H) + M (A = ∂M/∂H at H): the induced moment's
+/// "effective" magnetization, −∂e/∂H / (μ0 V) with e its Zeeman energy. Used by the Zeeman
+/// force, its reaction-symmetric form and ZeemanTotal.
+inline Vec3 zeeman_effective_magnetization(const Mat3& A, const Vec3& M, const Vec3& H) {
+  return A * (2.0 * M + H) + M;
+}
 /// Zeeman energy of one induced moment at equilibrium, E = −μ0 V f(H)·(f(H) + H) (eq. 3–4).
 double zeeman_energy(Curve curve, double V, double Ms, const Vec3& H);
 /// Classic force (eq. 13): F = μ0 (m·∇) H = μ0 J m, m held constant.

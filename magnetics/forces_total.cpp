@@ -54,22 +54,37 @@ void apply_S(const std::vector<Vec3>& u, const FieldOptions& field, MagWorkspace
 
 }  // namespace
 
+// (forces_total.hpp)
+void permanent_field(const MomentSet& set, const FieldOptions& field, MomentSet* scratch,
+                     std::vector<int>* perm, std::vector<Vec3>* Hp, std::vector<Mat3>* Jp,
+                     FieldWorkspace* ws) {
+  perm->clear();
+  *scratch = set;
+  for (std::size_t j = 0; j < set.size(); ++j) {
+    if (set.kind[j] == MomentKind::Induced)
+      scratch->M[j] = Vec3::Zero();
+    else
+      perm->push_back(static_cast<int>(j));
+  }
+  if (!perm->empty()) compute_fields_at(*scratch, field, *perm, Hp, Jp, ws);
+}
+
 void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& field,
                          MagWorkspace* ws, std::vector<Vec3>* F, std::vector<Vec3>* tau,
                          std::vector<Vec3>* F_classic, double tol, int max_iter) {
   ZeemanTotalScratch& t = ws->total;
   const std::size_t n = set.size();
   t.idx.clear();
-  t.perm.clear();
   for (std::size_t j = 0; j < n; ++j)
-    (set.kind[j] == MomentKind::Induced ? t.idx : t.perm).push_back(static_cast<int>(j));
+    if (set.kind[j] == MomentKind::Induced) t.idx.push_back(static_cast<int>(j));
   const std::size_t k = t.idx.size();
   if (t.w.size() != k) t.w.assign(k, Vec3::Zero());  // no warm start across a change of set
 
   // the sources of the adjoint field: induced moments only, no uniform field
   t.src = set;
   t.src.H0 = Vec3::Zero();
-  for (int p : t.perm) t.src.m_perm[p] = Vec3::Zero();
+  for (std::size_t j = 0; j < n; ++j)
+    if (set.kind[j] == MomentKind::Permanent) t.src.m_perm[j] = Vec3::Zero();
 
   // m̃_i = V_i [A_i (2M_i + H_i) + M_i],  B_i = (V_i A_i)^{1/2}
   t.mt.resize(k);
@@ -77,7 +92,7 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
   for (std::size_t a = 0; a < k; ++a) {
     const int j = t.idx[a];
     const Mat3 A = curve_dMdH(curve, ws->H[j], set.Ms[j]);
-    t.mt[a] = set.volume[j] * (A * (2.0 * set.M[j] + ws->H[j]) + set.M[j]);
+    t.mt[a] = set.volume[j] * zeeman_effective_magnetization(A, set.M[j], ws->H[j]);
     t.B[a] = sqrt_psd(set.volume[j] * 0.5 * (A + A.transpose()));
   }
 
@@ -122,12 +137,7 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
   compute_fields(t.src, field, &t.Hs, &t.Js, &ws->field);
 
   // the permanent moments' own field (with H0) at the permanent moments
-  if (!t.perm.empty()) {
-    MomentSet& perm_src = ws->effective;  // scratch
-    perm_src = set;
-    for (std::size_t a = 0; a < k; ++a) perm_src.M[t.idx[a]] = Vec3::Zero();
-    compute_fields_at(perm_src, field, t.perm, &t.Hp, &t.Jp, &ws->field);
-  }
+  permanent_field(set, field, &ws->effective, &t.perm, &t.Hp, &t.Jp, &ws->field);
 
   F->resize(n);
   if (tau) tau->resize(n);
@@ -173,15 +183,9 @@ double zeeman_total_energy(const MomentSet& set, Curve curve, const FieldOptions
                            FieldWorkspace* ws) {
   std::vector<Vec3> H, Hp;
   compute_fields(set, field, &H, nullptr, ws);
-  MomentSet perm_src = set;
+  MomentSet scratch;
   std::vector<int> perm;
-  for (std::size_t j = 0; j < set.size(); ++j) {
-    if (set.kind[j] == MomentKind::Induced)
-      perm_src.M[j] = Vec3::Zero();
-    else
-      perm.push_back(static_cast<int>(j));
-  }
-  if (!perm.empty()) compute_fields_at(perm_src, field, perm, &Hp, nullptr, ws);
+  detail::permanent_field(set, field, &scratch, &perm, &Hp, nullptr, ws);
   return zeeman_total_energy(set, curve, H, perm, Hp);
 }
 
