@@ -2,7 +2,8 @@
 """tools/ensemble.py — one scene, several perturbed runs: the spread of its outcome.
 
 A single run of a strongly magnetized pile is chaotic: removing one ball of 1032 moves the
-number of balls that fly off falling_magnet between 10 and 25 (issue #12). This runs the
+number of falling_magnet's balls more than 0.3 m from the magnet at 0.6 s between 10 and 25
+(issue #12). This runs the
 scene N times with --count BASE, BASE-1, ..., BASE-N+1 (one body fewer each time) and
 reports per run and over the runs: escaped (beyond the scene's escape_radius, summary.json
 "final"), held, the fastest body at the end and in the last second, and the error if the
