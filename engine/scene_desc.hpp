@@ -142,10 +142,12 @@ struct SimOptions {
   /// Adaptive rigid sub-steps: each frame of Δt_r is split into n ODE steps of Δt_r/n, each
   /// with its own magnetization solve (warm-started from the previous sub-step) and forces,
   ///   n = ⌈ max_b (|v_b| + |Δv_b|) Δt_r / (substep_reach · r_min) ⌉,  1 ≤ n ≤ max_substeps,
-  /// v_b the body's velocity at the frame's start, Δv_b its change over the last frame (it
+  /// over the dynamic bodies b that touched another body or the ground in the last frame
+  /// (a body in free flight moves ballistically and does not split the frame), v_b the
+  /// body's velocity at the frame's start, Δv_b its change over the last frame (it
   /// includes the contact forces, so a resting pile under a strong pull needs no sub-steps),
-  /// r_min the smallest inscribed radius of a dynamic body's shapes: no body moves more than
-  /// substep_reach · r_min per sub-step unless the cap binds. 1 = no sub-steps.
+  /// r_min the smallest inscribed radius of a dynamic body's shapes: no touching body moves
+  /// more than substep_reach · r_min per sub-step unless the cap binds. 1 = no sub-steps.
   int max_substeps = 1;
   double substep_reach = 0.25;     ///< fraction of r_min a body may cover per sub-step, > 0
   Vec3 gravity = Vec3(0, 0, -9.81);  ///< (m/s²)
