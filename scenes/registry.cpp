@@ -250,9 +250,10 @@ SceneDesc falling_magnet(const SceneParams& p) {
   // second at 50 fps: 0.21 0.32 0.07 0.06 m/s at 20 iterations (small avalanches down the
   // heap at 1.85 s: friction unconverged), 0.026 0.014 0.036 0.054 m/s at 50 (issue #12
   // asks ≤ 0.1). ODE does not warm-start contacts, so every step's friction starts from 0.
-  // Cost: T_r 11–14 → 25 ms, T_i+T_f+T_r 31–39 → 42 ms per frame (400 steps, 1 thread);
-  // the magnetized run's scatter does not change (balls > 0.3 m from the magnet at 0.6 s,
-  // 6 runs: mean 16.3 at 20, 17.0 at 80 iterations).
+  // Cost: T_r 11–14 → 25 ms; T_i+T_f+T_r per frame 27.3 ms (122b594), 30.4 (20 iterations),
+  // 39.8 (50), mean over 400 steps, median of 3 interleaved runs, 1 thread. The magnetized
+  // run's scatter does not change (balls > 0.3 m from the magnet at 0.6 s, 6 runs: mean
+  // 16.3 at 20, 15.2 at 50, 17.0 at 80 iterations).
   s.options.quickstep_iterations = 50;
   s.camera.eye = Eigen::Vector3f(0.26f, -0.32f, 0.22f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.03f);
