@@ -247,7 +247,7 @@ SceneDesc falling_magnet(const SceneParams& p) {
   s.options.rolling_friction = kRollingCoefficient * r;
   // 50 QuickStep iterations (ODE's 20 elsewhere): at 20 the heap does not stop creeping.
   // Control (no magnetism, 2 s, 4 runs with 1032…1029 balls), fastest ball in the last
-  // second at 50 fps: 0.21 0.32 0.07 0.06 m/s at 20 iterations (small avalanches down the
+  // second at 50 fps: 0.21 0.32 0.06 0.07 m/s at 20 iterations (small avalanches down the
   // heap at 1.85 s: friction unconverged), 0.026 0.014 0.036 0.054 m/s at 50 (issue #12
   // asks ≤ 0.1). ODE does not warm-start contacts, so every step's friction starts from 0.
   // Cost: T_r 11–14 → 25 ms; T_i+T_f+T_r per frame 27.3 ms (122b594), 30.4 (20 iterations),
