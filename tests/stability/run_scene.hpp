@@ -6,6 +6,7 @@
 #include "scenes/registry.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,15 +26,18 @@ struct SceneRun {
 };
 
 /// Runs `name` for `seconds` with `method`; the trailing window is the last `tail` seconds.
+/// `edit`, when given, changes the built scene before it runs (e.g. one of its options).
 inline SceneRun run_scene(const std::string& name, mag::Method method, double seconds,
                           double tail, int count = 0, double strength = 1.0,
-                          double dt_m = 0.0) {
+                          double dt_m = 0.0,
+                          const std::function<void(engine::SceneDesc&)>& edit = {}) {
   scenes::SceneParams p;
   p.count = count;
   p.strength = strength;
   engine::SceneDesc d = scenes::find_scene(name)->build(p);
   d.options.method = method;
   if (dt_m > 0) d.options.magnetics.dt = dt_m;
+  if (edit) edit(d);
   engine::Simulation sim(d);
   SceneRun r;
   const long n = static_cast<long>(seconds / d.options.dt + 0.5);
