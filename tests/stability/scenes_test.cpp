@@ -63,7 +63,7 @@ TEST_CASE("sakura_tree: balls land on the branch-end magnets and stay without be
   CHECK(r.last.attached >= 150);   // measured 205
 }
 
-TEST_CASE("alphabets at 300 A·m²: with rigid sub-steps the letters gather and stay; in one step per frame they are flung",
+TEST_CASE("alphabets at 300 A m^2: with rigid sub-steps the letters gather and stay, in one step per frame they are flung",
           "[stability][alphabets]") {
   // The bottom layer of the grid (25 letters, 10.5 cm below the 300 A·m² centre), 0.6 s:
   // they reach the collider at ≈ 0.2 s. Measured with the scene's up to 16 sub-steps (7.95
