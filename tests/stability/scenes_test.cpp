@@ -69,8 +69,8 @@ TEST_CASE("alphabets at 300 A m^2: with rigid sub-steps the letters gather and s
   // they reach the collider at ≈ 0.2 s. Measured with the scene's up to 16 sub-steps (7.95
   // per frame on average): all 25 held in the centre's cluster, none beyond 0.3 m, fastest
   // letter 24.3 m/s while gathering, 1.9 m/s at the end. The same run in one ODE step per
-  // frame (max_substeps 1, the scene before issue #12) reached 729 m/s and threw 18 letters
-  // out. Kim 2018 with the same sub-steps does not blow up either (it is not asserted): 13
+  // frame (max_substeps 1, how the scene ran before it had sub-steps) reached 729 m/s and
+  // threw 18 letters out. Kim 2018 with the same sub-steps does not blow up either (it is not asserted): 13
   // of 25 held at 0.6 s, none beyond 0.3 m, fastest 12.2 m/s; all 100 letters held at 2 s.
   const auto r = run_scene("alphabets", Method::OursRealigned, 0.6, 0.1, 25);
   INFO("held " << r.last.held << ", escaped " << r.last.escaped << ", fastest " << r.max_speed
