@@ -70,8 +70,9 @@ TEST_CASE("alphabets at 300 A m^2: with rigid sub-steps the letters gather and s
   // per frame on average): all 25 held in the centre's cluster, none beyond 0.3 m, fastest
   // letter 24.3 m/s while gathering, 1.9 m/s at the end. The same run in one ODE step per
   // frame (max_substeps 1, how the scene ran before it had sub-steps) reached 729 m/s and
-  // threw 18 letters out. Kim 2018 with the same sub-steps does not blow up either (it is not asserted): 13
-  // of 25 held at 0.6 s, none beyond 0.3 m, fastest 12.2 m/s; all 100 letters held at 2 s.
+  // threw 18 letters out. Kim 2018 with the same sub-steps does not blow up either (it is
+  // not asserted): 13 of 25 held at 0.6 s, none beyond 0.3 m, fastest 12.2 m/s; all 100
+  // letters held at 2 s.
   const auto r = run_scene("alphabets", Method::OursRealigned, 0.6, 0.1, 25);
   INFO("held " << r.last.held << ", escaped " << r.last.escaped << ", fastest " << r.max_speed
                << " m/s, at the end " << r.last.max_speed << " m/s");
