@@ -303,6 +303,26 @@ struct OdeBridge::Impl {
     for (int k = 0; k < n; ++k) self->recs.push_back(ContactRec{t1->shape, t2->shape, k, self->buf[k]});
   }
 
+  // How far geom s, grown by μ = shape_margin[s] (grow_geom), reaches beyond its shape along
+  // the unit normal n: the difference of the two support functions, h_grown(n) − h(n).
+  // Contact depths of convex shapes are support overlaps along the normal, so this is what
+  // the margin adds to a depth. A sphere or capsule grows by μ in every direction; a box
+  // whose half extents all grow by μ reaches μ Σ_i |n·a_i| (a_i its axes), up to √3 μ along a
+  // corner's diagonal; a cylinder, whose radius and half length grow, μ (|n·z| + √(1−(n·z)²)).
+  // Subtracting μ alone there read a box corner lying a gap away as penetrating by up to
+  // (√3 − 1) μ, and the error reduction pushed it out against the magnet (issue #12).
+  double margin_along(int s, const dVector3 n) const {
+    const double mu = shape_margin[s];
+    if (mu == 0.0 || s == model.nshape) return mu;  // not grown; the ground plane
+    const ShapeKind kind = model.shape_kind[s];
+    if (kind == ShapeKind::Sphere || kind == ShapeKind::Capsule) return mu;
+    const dReal* R = dGeomGetRotation(geom[s]);  // 3×4, row major: column i = axis i
+    auto along = [&](int i) { return std::abs(n[0] * R[i] + n[1] * R[4 + i] + n[2] * R[8 + i]); };
+    if (kind == ShapeKind::Box) return mu * (along(0) + along(1) + along(2));
+    const double z = std::min(1.0, along(2));  // cylinder: axis = local z
+    return mu * (z + std::sqrt(1.0 - z * z));
+  }
+
   int collide(std::vector<std::pair<int, int>>* pairs, double dt) {
     ensure_thread_data();
     recs.clear();
@@ -320,7 +340,6 @@ struct OdeBridge::Impl {
     std::sort(order.begin(), order.end());
     pairs->clear();
     const double touch = 0.1 * margin;  // gaps below this count as touching (metrics)
-    const double* mu = shape_margin.data();
     dContact c;
     for (const auto& [key, idx] : order) {
       const ContactRec& r = recs[idx];
@@ -329,8 +348,10 @@ struct OdeBridge::Impl {
       // contact of a pile doubled QuickStep's time (falling_magnet T_r 9.1 → 18.9 ms)
       c.surface = tag[r.a].dynamic && tag[r.b].dynamic ? surface : rolling;
       c.geom = r.g;
-      // true depth d = depth of the grown geoms − the margins they were grown by
-      const double d = r.g.depth - mu[r.a] - mu[r.b];
+      // true depth d = depth of the grown geoms − how far each grown geom reaches beyond
+      // its shape along the contact normal (margin_along: μ for spheres and capsules, more
+      // for a box's edges and corners)
+      const double d = r.g.depth - margin_along(r.a, r.g.normal) - margin_along(r.b, r.g.normal);
       if (d < 0) {
         // speculative: a gap g = −d may close within this step but not more,
         // J v ≥ −g/Δt (ODE's contact row: J v ≥ k·depth + motionN, here depth = 0)

@@ -150,6 +150,11 @@ struct SimOptions {
   /// more than substep_reach · r_min per sub-step unless the cap binds. 1 = no sub-steps.
   int max_substeps = 1;
   double substep_reach = 0.25;     ///< fraction of r_min a body may cover per sub-step, > 0
+  /// The load term of the sub-steps: also n ≥ ⌈√(a_b / (substep_reach · r_min)) Δt_r⌉ with
+  /// a_b = |F_b|/m_b the magnetic acceleration of a touching body b in the last frame, so
+  /// that a body pressed into its contacts by the magnet sinks at most substep_reach · r_min
+  /// per sub-step where QuickStep leaves the load unbalanced (substeps.cpp). false = motion only.
+  bool substep_load = true;
   Vec3 gravity = Vec3(0, 0, -9.81);  ///< (m/s²)
   bool ground = true;              ///< an infinite static plane z = 0
   double friction = 0.5;           ///< Coulomb μ; 0 = frictionless contacts

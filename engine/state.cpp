@@ -13,6 +13,7 @@ State initial_state(const Model& m) {
   s.vel = m.body_vel0;
   s.angvel = m.body_angvel0;
   s.dvel.assign(m.nbody, Vec3::Zero());
+  s.mag_accel.assign(m.nbody, 0.0);
   s.enabled.assign(m.nbody, 1);
   s.M1.assign(m.nmoment, Vec3::Zero());
   s.M2.assign(m.nmoment, Vec3::Zero());
@@ -71,6 +72,10 @@ void check_state_shape(const Model& m, const State& s) {
   if (!s.dvel.empty() && s.dvel.size() != nb)
     throw std::invalid_argument("State does not fit the model: dvel has " +
                                 std::to_string(s.dvel.size()) + " entries, expected " +
+                                std::to_string(nb) + " (or none)");
+  if (!s.mag_accel.empty() && s.mag_accel.size() != nb)
+    throw std::invalid_argument("State does not fit the model: mag_accel has " +
+                                std::to_string(s.mag_accel.size()) + " entries, expected " +
                                 std::to_string(nb) + " (or none)");
   if (s.step < 0) throw std::invalid_argument("State step count is negative");
 }

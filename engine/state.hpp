@@ -33,6 +33,10 @@ struct State {
   /// step's number of rigid sub-steps (SimOptions::max_substeps). Derived data kept so that
   /// a restored state continues as the original; not part of the hash. Empty = zero.
   std::vector<Vec3> dvel;
+  /// (nbody) m/s²: |F|/m of each body's magnetic force in the last step, the load term of
+  /// the next step's sub-steps (SimOptions::substep_load). Derived data as dvel: kept so that
+  /// a restored state continues as the original; not part of the hash. Empty = zero.
+  std::vector<double> mag_accel;
 };
 
 /// The state at t = 0: the scene's poses and velocities, unmagnetized induced moments.

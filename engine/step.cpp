@@ -127,6 +127,9 @@ void Simulation::step() {
       check_bodies(m, next, n);
       next.dvel.resize(m.nbody);
       for (int b = 0; b < m.nbody; ++b) next.dvel[b] = next.vel[b] - state_.vel[b];
+      next.mag_accel.assign(m.nbody, 0.0);
+      if (m.dynamic_moments)
+        for (int b : m.dynamic_bodies) next.mag_accel[b] = ws_.body_force[b].norm() / m.body_mass[b];
       // energy audit: the work of the last ODE step (O(bodies)); U_mag from the forces' field
       audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque, h,
                     &ws_.audit);

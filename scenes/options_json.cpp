@@ -96,6 +96,7 @@ json to_json(const SimOptions& o) {
               {"force_model", engine::force_choice_name(o.force_model)},
               {"max_substeps", o.max_substeps},
               {"substep_reach", o.substep_reach},
+              {"substep_load", o.substep_load},
               {"rolling_friction", o.rolling_friction},
               {"max_body_speed", o.max_body_speed},
               {"field_solver", mag::field_solver_name(f.solver)},
@@ -148,7 +149,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
                    "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
-                   "magnetics", "force_model", "max_substeps", "substep_reach", "rolling_friction",
+                   "magnetics", "force_model", "max_substeps", "substep_reach", "substep_load", "rolling_friction",
                    "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
                    "bh_near_float", "bh_far_float"});
   if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
@@ -178,6 +179,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   });
   if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = r.integer(v, p, 1, 64); });
   if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.positive(v, p); });
+  if_present(j, "substep_load", path, [&](const json& v, const std::string& p) { o->substep_load = r.boolean(v, p); });
   if_present(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.non_negative(v, p); });
   if_present(j, "quickstep_w", path, [&](const json& v, const std::string& p) {
     o->quickstep_w = r.number(v, p);

@@ -52,6 +52,7 @@ SimOptions all_changed() {
   o.dt = 5e-4;
   o.max_substeps = 6;
   o.substep_reach = 0.4;
+  o.substep_load = false;
   o.gravity = Vec3(0.1, -0.2, -3.7);
   o.ground = false;
   o.friction = 0.31;
@@ -108,6 +109,7 @@ void check_equal(const SimOptions& a, const SimOptions& b) {
   CHECK(a.dt == b.dt);
   CHECK(a.max_substeps == b.max_substeps);
   CHECK(a.substep_reach == b.substep_reach);
+  CHECK(a.substep_load == b.substep_load);
   CHECK(a.gravity == b.gravity);
   CHECK(a.ground == b.ground);
   CHECK(a.friction == b.friction);
@@ -141,7 +143,7 @@ SimOptions read_back(const nlohmann::json& j) {
 // all_changed and check_equal above (and SCENE_FILE.md), then update the size here.
 static_assert(sizeof(mag::FieldOptions) == 48, "FieldOptions changed: extend scenes/options_json.cpp");
 static_assert(sizeof(mag::DynamicsOptions) == 152, "DynamicsOptions changed: extend scenes/options_json.cpp");
-static_assert(sizeof(SimOptions) == 352, "SimOptions changed: extend scenes/options_json.cpp");
+static_assert(sizeof(SimOptions) == 360, "SimOptions changed: extend scenes/options_json.cpp");
 
 TEST_CASE("options_json: every field, away from its default, survives to_json and from_json", "[options_json]") {
   const SimOptions o = all_changed();

@@ -58,6 +58,27 @@ TEST_CASE("state: save/restore round-trips and reproduces the continuation", "[s
   CHECK(other.state_hash() == h200);
 }
 
+TEST_CASE("state: a restored state keeps the sub-step choice of the original", "[state][substeps]") {
+  // the number of sub-steps reads the last frame's velocity change and magnetic load
+  // (State::dvel, State::mag_accel): a fresh simulation restored from a state must split
+  // its frames as the original did
+  SceneDesc s = pile_under_magnet(3, 4.0);
+  s.options.max_substeps = 16;
+  engine::Simulation sim(s);
+  sim.run(60);
+  const engine::State saved = sim.save_state();
+  int split = 0;
+  for (int k = 0; k < 40; ++k) {
+    sim.step();
+    split += sim.last_profile().substeps > 1;
+  }
+  REQUIRE(split > 0);  // the test means something only if frames were split
+  engine::Simulation other(s);
+  other.restore_state(saved);
+  other.run(40);
+  CHECK(other.state_hash() == sim.state_hash());
+}
+
 TEST_CASE("state: restore rejects a state of another model or with non-finite values", "[state]") {
   engine::Simulation sim(pile_under_magnet(2));
   engine::Simulation small(pile_under_magnet(1));

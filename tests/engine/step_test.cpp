@@ -270,3 +270,83 @@ TEST_CASE("step: only bodies in contact split a frame into sub-steps", "[step][s
     }
   }
 }
+
+namespace {
+// no gravity, no ground, one magnetics thread
+SceneDesc weightless() {
+  SceneDesc s;
+  s.options.threads = 1;
+  s.options.gravity = Vec3::Zero();
+  s.options.ground = false;
+  return s;
+}
+}  // namespace
+
+TEST_CASE("step: the magnetic load splits the frames of a body pressed into its contact", "[step][substeps]") {
+  // SimOptions::substep_load: n ≥ ⌈√(a / (reach · r)) Δt_r⌉, a = |F|/m of a touching body.
+  // An iron ball rests on a strong cube magnet (no gravity): it does not move, but the magnet
+  // presses it into the contact at ~10⁴ m/s².
+  SceneDesc s = weightless();
+  s.options.max_substeps = 16;
+  s.bodies.push_back(cube_magnet(Vec3::Zero(), Vec3(0, 0, 5.0)));
+  s.bodies.push_back(iron_ball("ball", Vec3(0, 0, 0.005 + kR)));
+  SECTION("on (default): the load sets the sub-steps") {
+    engine::Simulation sim(s);
+    sim.run(5);
+    for (int k = 0; k < 10; ++k) {
+      const double a = sim.state().mag_accel[1];
+      const int expected = std::min(16, static_cast<int>(std::ceil(std::sqrt(a / (0.25 * kR)) * 1e-3)));
+      REQUIRE(expected >= 3);  // a strong pull
+      sim.step();
+      CHECK(sim.last_profile().substeps == expected);
+    }
+    CHECK(sim.body_velocity(1).norm() < 1e-3);  // still resting
+  }
+  SECTION("off: a resting ball is not split") {
+    s.options.substep_load = false;
+    engine::Simulation sim(s);
+    for (int k = 0; k < 15; ++k) {
+      sim.step();
+      CHECK(sim.last_profile().substeps == 1);
+    }
+    CHECK(sim.state().mag_accel[1] > 1e4);  // the same load
+  }
+}
+
+TEST_CASE("step: a box corner a gap away from a sphere reads as a gap, not a penetration", "[step]") {
+  // A box's contact margin μ grows its half extents, so along its body diagonal the grown
+  // box reaches √3 μ beyond the corner (ode_bridge.cpp, margin_along). Read as μ, the corner
+  // of a box 1 mm from a sphere, margin 2 mm, would penetrate by 0.46 mm and be pushed away.
+  SceneDesc s = weightless();
+  s.options.contact_margin = 0.002;
+  const double R = 0.01, h = 0.005, gap = 0.001;
+  BodyDesc sphere;
+  sphere.name = "sphere";
+  sphere.type = BodyType::Static;
+  sphere.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(R, R, R)});
+  s.bodies.push_back(sphere);
+  BodyDesc box;
+  box.name = "box";
+  // the corner (−h, −h, −h) points straight down at the sphere
+  box.orientation = Quat::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, 0, -1));
+  box.position = Vec3(0, 0, R + gap + std::sqrt(3.0) * h);
+  box.shapes.push_back({ShapeKind::Box, Vec3::Zero(), Quat::Identity(), Vec3(h, h, h)});
+  auto corner_height = [&](const engine::Simulation& sim) {
+    return (sim.body_position(1) + sim.body_orientation(1) * Vec3(-h, -h, -h)).z();
+  };
+  SECTION("at rest: it stays where it is") {
+    s.bodies.push_back(box);
+    engine::Simulation sim(s);
+    sim.run(10);
+    CHECK(sim.body_velocity(1).norm() < 1e-9);
+    CHECK(corner_height(sim) == Approx(R + gap).margin(1e-9));
+  }
+  SECTION("moving toward the sphere: it stops on the surface, not short of it or inside") {
+    box.velocity = Vec3(0, 0, -0.5);  // 0.5 mm per step
+    s.bodies.push_back(box);
+    engine::Simulation sim(s);
+    sim.run(20);
+    CHECK(corner_height(sim) == Approx(R).margin(1e-4));
+    CHECK(sim.body_velocity(1).z() > -1e-3);
+  }
+}

@@ -15,6 +15,9 @@ namespace magsim::test {
 struct SceneRun {
   engine::Metrics last;
   double tail_max_speed = 0;     ///< max body speed over the trailing window (m/s)
+  /// the same over the bodies not escaped (Metrics::escaped) at each sample: what is left
+  /// around the magnet, without the few thrown off that slide on for ever (m/s)
+  double tail_max_speed_inside = 0;
   double tail_max_ke = 0;        ///< max kinetic energy over the trailing window (J)
   double max_speed = 0;          ///< over the whole run (m/s)
   double max_bounding_radius = 0;
@@ -24,6 +27,15 @@ struct SceneRun {
   std::string error;
   std::uint64_t hash = 0;
 };
+
+/// max |v| over the dynamic bodies that are not escaped (engine::escaped_bodies)
+inline double speed_inside(const engine::Simulation& sim) {
+  const std::vector<int> out = engine::escaped_bodies(sim.model(), sim.state());
+  double v = 0;
+  for (int b : sim.model().dynamic_bodies)
+    if (!std::binary_search(out.begin(), out.end(), b)) v = std::max(v, sim.state().vel[b].norm());
+  return v;
+}
 
 /// Runs `name` for `seconds` with `method`; the trailing window is the last `tail` seconds.
 /// `edit`, when given, changes the built scene before it runs (e.g. one of its options).
@@ -53,6 +65,7 @@ inline SceneRun run_scene(const std::string& name, mag::Method method, double se
       r.max_bounding_radius = std::max(r.max_bounding_radius, m.bounding_radius);
       if (k >= tail_from) {
         r.tail_max_speed = std::max(r.tail_max_speed, m.max_speed);
+        r.tail_max_speed_inside = std::max(r.tail_max_speed_inside, speed_inside(sim));
         r.tail_max_ke = std::max(r.tail_max_ke, m.kinetic_energy);
         r.min_attached_tail = std::min(r.min_attached_tail, m.attached);
       }

@@ -61,6 +61,7 @@ struct Args {
   std::string force_model;
   int max_substeps = 0;
   double substep_reach = 0.0;
+  std::string substep_load;
   double rolling_friction = 0.0;
   double quickstep_w = 0.0;
   double dt = 0.0;

@@ -81,6 +81,11 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman, classic or zeeman-total)");
   if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
   if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
+  if (app.count("--substep-load")) {
+    if (a.substep_load != "on" && a.substep_load != "off")
+      throw UsageError("--substep-load: expected on or off, got '" + a.substep_load + "'");
+    s.options.substep_load = a.substep_load == "on";
+  }
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
   if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
   if (app.count("--dt")) s.options.dt = a.dt;
@@ -174,11 +179,15 @@ int main(int argc, char** argv) {
                  "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) | zeeman-total (eq. 4 as the gradient "
                  "of the system's Zeeman energy: conservative) (default: the scene's, method)");
   app.add_option("--max-substeps", a.max_substeps,
-                 "most rigid sub-steps per frame; a frame is split when bodies in contact move fast (1 = never; default: the scene's)")
+                 "most rigid sub-steps per frame; a frame is split when bodies in contact move fast or are "
+                 "pressed hard by the magnetic force (1 = never; default: the scene's)")
       ->check(CLI::Range(1, 64));
   app.add_option("--substep-reach", a.substep_reach,
                  "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--substep-load", a.substep_load,
+                 "on | off: also split a frame by the magnetic acceleration a of bodies in contact, "
+                 "a h^2 <= reach * r_min per sub-step (default on)");
   app.add_option("--rolling-friction", a.rolling_friction,
                  "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
       ->check(CLI::NonNegativeNumber);
