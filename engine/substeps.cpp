@@ -15,9 +15,10 @@
 //    contacts in a sub-step of h; the error reduction then pushes it out against the magnet,
 //    which pulls it back in at about a h √(2ε). In alphabets (letters pressed onto the
 //    collider at ~10⁵ m/s²) the contacts' largest pushes, up to 12.6 J of work in a frame,
-//    came right after frames of a single sub-step (25 letters, each step traced; issue #12). Scenes whose piles rest under such loads split every frame: alphabets 13
-//    sub-steps per frame, and the magnetization, re-solved per sub-step from a nearer start,
-//    converges where it hit its cap before (35 frames of 2000 instead of 1531).
+//    came right after frames of a single sub-step (25 letters, each step traced; issue
+//    #12). Scenes whose piles rest under such loads split every frame: alphabets 13
+//    sub-steps per frame, and the magnetization, re-solved per sub-step from a nearer
+//    start, converges where it hit its cap before (35 frames of 2000 instead of 1531).
 #include "engine/stages.hpp"
 
 #include <algorithm>
@@ -45,7 +46,8 @@ int choose_substeps(const Model& m, const State& s) {
     consider(b);
   }
   const double reach = o.substep_reach * m.min_dynamic_radius;
-  const double n = std::max(std::ceil(speed * o.dt / reach), std::ceil(std::sqrt(acc / reach) * o.dt));
+  const double n =
+      std::max(std::ceil(speed * o.dt / reach), std::ceil(std::sqrt(acc / reach) * o.dt));
   if (!(n > 1)) return 1;  // also NaN (the safety check names the body afterwards)
   return n >= o.max_substeps ? o.max_substeps : static_cast<int>(n);
 }

@@ -134,11 +134,11 @@ SceneDesc balls_up(const SceneParams& p) {
 // letters pressed onto the collider at ~10⁵ m/s²). Measured, 2 s, 1 thread: all 100
 // letters held, none beyond 0.3 m; fastest letter 15 m/s (gathering), 0.41 m/s in the last
 // second, 0.05 m/s at the end; 13.2 sub-steps per frame on average, the magnetization at its
-// cap in 35 of 2000 frames, median T_i 17 + T_f 1.8 + T_r 161 ms per frame (the paper's T_r:
-// 110 ms). `--strength 3` (900 A·m²): 100 held, 0.20 m/s in the last second, 16 sub-steps,
-// 320 ms per frame. Without the load term (`substep_load` false: 5.8 sub-steps per frame):
-// 3.0 m/s in the last second, 0.67 at the end, the cap in 1531 frames, T_i 43 + T_f 0.6 +
-// T_r 120 ms. Kim 2018 with the same sub-steps also holds all 100 but keeps them moving:
+// cap in 35 of 2000 frames, median T_i 9.1 + T_f 1.7 + T_r 79 ms per frame (the paper's T_r:
+// 110 ms; the code before both fixes 42 + 0.7 + 82, run side by side). `--strength 3` (900 A·m²):
+// 100 held, 0.20 m/s in the last second, 16 sub-steps. Without the load term (`substep_load`
+// false: 5.8 sub-steps per frame): 3.0 m/s in the last second, 0.67 at the end, the cap in
+// 1531 frames. Kim 2018 with the same sub-steps also holds all 100 but keeps them moving:
 // 3.1 m/s in the last second, the cap in 1866 frames; Fig. 4-(c)'s blow-up does not
 // reproduce. `--strength 0.1` gives the earlier 30 A·m² scene (without sub-steps it threw 2
 // letters out, 67 held, 4.3 m/s at 2 s).
