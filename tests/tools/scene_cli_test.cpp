@@ -97,6 +97,8 @@ TEST_CASE("magsim-scene refuses bad ODE flags with a message and exit code 1", "
       {"balls_up --steps 1 --no-render --softening -0.001", "--softening"},
       {"balls_up --steps 1 --no-render --softening 1", "--softening"},
       {"balls_up --steps 1 --no-render --force-model total", "--force-model"},
+      {"balls_up --steps 1 --no-render --substep-load maybe", "--substep-load"},
+      {"balls_up --steps 1 --no-render --bounded-pairs yes", "--bounded-pairs"},
   };
   for (const Case& c : cases) {
     const Result r = run_scene(c.args);
@@ -111,6 +113,7 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   const std::string out = tmp_dir("replay");
   const Result r = run_scene("balls_up --count 27 --steps 50 --no-render --space hash --dt-m 8e-8 --tol 3e-5 "
                              "--quickstep-iterations 40 --quickstep-w 1.2 --rolling-friction 1e-4 --max-substeps 2 "
+                             "--substep-load off "
                              "--method anderson --threads 1 --out " + out);
   INFO(r.out);
   REQUIRE(r.code == 0);
@@ -118,6 +121,7 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   const auto summary = nlohmann::json::parse(f);
   CHECK(summary["options"]["magnetics"]["dt"] == 8e-8);
   CHECK(summary["options"]["method"] == "anderson");
+  CHECK(summary["options"]["substep_load"] == false);
   // the registry scene's bodies with the summary's options, read as a scene file
   magsim::scenes::SceneParams p;
   p.count = 27;

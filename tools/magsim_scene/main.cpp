@@ -40,6 +40,13 @@ int max_threads() {
   return 4 * static_cast<int>(cores > 0 ? cores : 1);
 }
 
+// the value of an on | off flag
+bool on_off(const char* flag, const std::string& value) {
+  if (value != "on" && value != "off")
+    throw UsageError(std::string(flag) + ": expected on or off, got '" + value + "'");
+  return value == "on";
+}
+
 }  // namespace
 
 // The scene named on the command line, with the command line's overrides applied.
@@ -81,19 +88,12 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman, classic or zeeman-total)");
   if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
   if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
-  if (app.count("--substep-load")) {
-    if (a.substep_load != "on" && a.substep_load != "off")
-      throw UsageError("--substep-load: expected on or off, got '" + a.substep_load + "'");
-    s.options.substep_load = a.substep_load == "on";
-  }
+  if (app.count("--substep-load")) s.options.substep_load = on_off("--substep-load", a.substep_load);
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
   if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
   if (app.count("--dt")) s.options.dt = a.dt;
-  if (app.count("--bounded-pairs")) {
-    if (a.bounded_pairs != "on" && a.bounded_pairs != "off")
-      throw UsageError("--bounded-pairs: expected on or off, got '" + a.bounded_pairs + "'");
-    s.options.magnetics.field.bounded_pairs = a.bounded_pairs == "on";
-  }
+  if (app.count("--bounded-pairs"))
+    s.options.magnetics.field.bounded_pairs = on_off("--bounded-pairs", a.bounded_pairs);
   if (app.count("--softening")) s.options.magnetics.field.softening = a.softening;
   if (app.count("--space")) {
     if (!engine::parse_space(a.space, &s.options.space))
