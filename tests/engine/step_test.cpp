@@ -8,6 +8,17 @@
 using namespace magsim;
 using namespace magsim::test;
 
+namespace {
+// no gravity, no ground, one magnetics thread
+SceneDesc weightless() {
+  SceneDesc s;
+  s.options.threads = 1;
+  s.options.gravity = Vec3::Zero();
+  s.options.ground = false;
+  return s;
+}
+}  // namespace
+
 TEST_CASE("step: a sphere dropped on the plane comes to rest at its radius", "[step]") {
   const double r = 0.01;
   SceneDesc s;
@@ -25,11 +36,8 @@ TEST_CASE("step: a sphere dropped on the plane comes to rest at its radius", "[s
 }
 
 TEST_CASE("step: an iron ball released near a fixed magnet moves toward it", "[step]") {
-  SceneDesc s;
+  SceneDesc s = weightless();
   s.options.method = mag::Method::OursRealigned;  // converges in weak fields (DESIGN §6)
-  s.options.threads = 1;
-  s.options.gravity = Vec3::Zero();
-  s.options.ground = false;
   s.bodies.push_back(cube_magnet(Vec3(0, 0, 0), Vec3(0, 0, 1.0)));
   s.bodies.push_back(iron_ball("ball", Vec3(0.001, 0, -0.03)));
   engine::Simulation sim(s);
@@ -103,11 +111,8 @@ TEST_CASE("step: every method runs and pulls a ball toward the magnet", "[step]"
   for (mag::Method method : {mag::Method::Ours, mag::Method::OursRealigned, mag::Method::Kim2018,
                              mag::Method::DampingLLG, mag::Method::Exact}) {
     INFO(mag::method_name(method));
-    SceneDesc s;
+    SceneDesc s = weightless();
     s.options.method = method;
-    s.options.threads = 1;
-    s.options.gravity = Vec3::Zero();
-    s.options.ground = false;
     s.bodies.push_back(cube_magnet(Vec3(0, 0, 0), Vec3(0, 0, 1.0)));
     s.bodies.push_back(iron_ball("ball_0", Vec3(0.0, 0, -0.03)));
     s.bodies.push_back(iron_ball("ball_1", Vec3(0.012, 0, -0.03)));
@@ -270,17 +275,6 @@ TEST_CASE("step: only bodies in contact split a frame into sub-steps", "[step][s
     }
   }
 }
-
-namespace {
-// no gravity, no ground, one magnetics thread
-SceneDesc weightless() {
-  SceneDesc s;
-  s.options.threads = 1;
-  s.options.gravity = Vec3::Zero();
-  s.options.ground = false;
-  return s;
-}
-}  // namespace
 
 TEST_CASE("step: the magnetic load splits the frames of a body pressed into its contact", "[step][substeps]") {
   // SimOptions::substep_load: n ≥ ⌈√(a / (reach · r)) Δt_r⌉, a = |F|/m of a touching body.
