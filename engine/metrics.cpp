@@ -74,10 +74,15 @@ std::vector<int> find_escaped(const Model& m, const State& s) {
 
 std::vector<int> escaped_bodies(const Model& m, const State& s) { return find_escaped(m, s); }
 
+double rotational_energy(const Model& m, const State& s, int b) {
+  // ½ ωᵀ (R I Rᵀ) ω = ½ ω_bᵀ I ω_b with ω_b = Rᵀ ω the body-frame angular velocity
+  const Vec3 w_body = s.quat[b].toRotationMatrix().transpose() * s.angvel[b];
+  return 0.5 * w_body.dot(m.body_inertia[b] * w_body);
+}
+
 double kinetic_energy(const Model& m, const State& s, int b) {
   // E = ½ m |v|² + ½ ωᵀ (R I Rᵀ) ω
-  const Vec3 w_body = s.quat[b].toRotationMatrix().transpose() * s.angvel[b];
-  return 0.5 * m.body_mass[b] * s.vel[b].squaredNorm() + 0.5 * w_body.dot(m.body_inertia[b] * w_body);
+  return 0.5 * m.body_mass[b] * s.vel[b].squaredNorm() + rotational_energy(m, s, b);
 }
 
 Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last) {
@@ -94,6 +99,7 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
     const double mass = m.body_mass[b];
     const Vec3& v = s.vel[b];
     r.kinetic_energy += kinetic_energy(m, s, b);
+    r.rotational_energy += rotational_energy(m, s, b);
     r.max_speed = std::max(r.max_speed, v.norm());
     r.momentum += mass * v;
     centroid += s.pos[b];

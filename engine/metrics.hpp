@@ -11,6 +11,9 @@ struct Metrics {
   long steps = 0;
   int dynamic_bodies = 0;
   double kinetic_energy = 0.0;   ///< Σ ½ m |v|² + ½ ωᵀ I_world ω over dynamic bodies (J)
+  /// the rotational part Σ ½ ωᵀ I_world ω of kinetic_energy (J): balls spinning in place
+  /// hold kinetic energy that no speed or displacement shows
+  double rotational_energy = 0.0;
   double max_speed = 0.0;        ///< max |v| over dynamic bodies (m/s)
   double bounding_radius = 0.0;  ///< max |x_i − x̄| over dynamic bodies, x̄ their centroid (m)
   /// max |x_i − x_magnet| over dynamic bodies other than the first magnet body (m); 0 when
@@ -44,5 +47,7 @@ std::vector<int> escaped_bodies(const Model& model, const State& s);
 /// Kinetic energy of one body, ½ m |v|² + ½ ωᵀ I_world ω (J); the one formula of the
 /// metrics and the energy audit.
 double kinetic_energy(const Model& model, const State& s, int body);
+/// Its rotational part ½ ωᵀ I_world ω (J).
+double rotational_energy(const Model& model, const State& s, int body);
 
 }  // namespace magsim::engine

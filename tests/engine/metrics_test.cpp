@@ -28,6 +28,7 @@ TEST_CASE("metrics: kinetic energy, momentum, speed and radius of free bodies", 
   const engine::Metrics x = sim.metrics();
   CHECK(x.dynamic_bodies == 2);
   CHECK(x.kinetic_energy == Approx(0.5 * m * 5.0 + 0.5 * I * 9.0));
+  CHECK(x.rotational_energy == Approx(0.5 * I * 9.0));
   CHECK((x.momentum - m * Vec3(1, 2, 0)).norm() < 1e-15);
   CHECK(x.max_speed == Approx(std::sqrt(5.0)));
   CHECK(x.bounding_radius == Approx(0.03));

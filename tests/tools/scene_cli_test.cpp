@@ -54,6 +54,9 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
                          e["gravity_drift"].get<double>();
   CHECK(std::abs(balance) <= 1e-12 + 1e-9 * std::abs(e["magnetic_work"].get<double>()));
   CHECK(e["kinetic"].get<double>() == Approx(j["final"]["kinetic_energy"].get<double>()).epsilon(1e-12));
+  // the rotational part of the final kinetic energy: balls rolling on one another spin
+  CHECK(j["final"]["rotational_energy"].get<double>() >= 0);
+  CHECK(j["final"]["rotational_energy"].get<double>() <= j["final"]["kinetic_energy"].get<double>());
   CHECK(e["magnetic_energy"].get<double>() < 0);  // iron drawn to the magnet: bound
   CHECK(e["escaped_bodies"]["count"] == j["final"]["escaped"]);
   CHECK(e["contact_work_in"].get<double>() >= 0);

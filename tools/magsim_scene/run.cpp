@@ -227,6 +227,7 @@ int run(const Args& a, const CLI::App& app) {
         {"mean", substeps.empty() ? 0.0 : sum(substeps) / static_cast<double>(substeps.size())}}},
       {"final",
        {{"kinetic_energy", fin.kinetic_energy},
+        {"rotational_energy", fin.rotational_energy},
         {"max_speed", fin.max_speed},
         {"bounding_radius", fin.bounding_radius},
         {"magnet_radius", fin.magnet_radius},
