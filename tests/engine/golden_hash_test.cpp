@@ -51,7 +51,7 @@ TEST_CASE("golden state hashes: the five registry scenes after 100 steps", "[gol
     const char* hash;
   };
   const Golden golden[] = {
-      {"balls_up", "6f433b16efcacbb9"},
+      {"balls_up", "df80fd99e159930a"},
       {"alphabets", "ef63f122b5ad78aa"},
       {"falling_magnet", "cbff11848f5a81ef"},
       {"sakura_tree", "94023250a909d217"},
