@@ -118,7 +118,7 @@ SceneDesc balls_up(const SceneParams& p) {
   // fastest ball of the last second 0.20 m/s instead of 2.8; 1.27 sub-steps per frame,
   // median step 3.98 ms against 4.01, wall 10.4 s against 8.5. Without them the robustness
   // matrix (tools/robustness.sh, 1 s, 20 or 50 QuickStep iterations instead of these 100)
-  // broke 20 m/s in 17 of 24 runs, among them W 1.3, 20 iterations, 1 ms, ×1 (81 m/s, 237
+  // broke 20 m/s in 16 of 24 runs, among them W 1.3, 20 iterations, 1 ms, ×1 (81 m/s, 237
   // balls thrown) and every run at ×3 but one; with them in none (peaks at 60 fps 4.4–17.9
   // m/s, final KE ≤ 0.69 J).
   s.options.max_substeps = 8;
