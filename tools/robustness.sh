@@ -5,10 +5,13 @@
 # with finite metrics, and no body faster than the bound (default 20 m/s) at any frame.
 #
 #   bash tools/robustness.sh [--seconds S] [--scenes a,b] [--bound V] [--out DIR] [--quick]
+#                            [--flags "MAGSIM-SCENE FLAGS"]
 # Writes DIR/<scene>_<case>/summary.json and DIR/robustness.md (default DIR:
 # out/robustness); exits 1 when a run breaks the bound. --quick runs the corner cases only
-# (W 1.0 with 20 iterations and Δt_r 2 ms at ×3, and the defaults at ×3). At the default
-# 1 s, the full matrix takes about 1 h on 2 cores (sakura_tree dominates).
+# (W 1.0 with 20 iterations and Δt_r 2 ms at ×3, and the defaults at ×3). --flags passes
+# more magsim-scene flags to every run (e.g. "--bounded-pairs on"), to test a mechanism
+# across the matrix. At the default 1 s, the full matrix takes about 1 h on 2 cores
+# (sakura_tree dominates).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=1
@@ -16,6 +19,7 @@ scenes=balls_up,alphabets,falling_magnet,sakura_tree
 bound=20
 out=out/robustness
 quick=0
+flags=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -23,7 +27,8 @@ while [ $# -gt 0 ]; do
     --bound) bound="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --quick) quick=1; shift ;;
-    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --flags) flags="$2"; shift 2 ;;
+    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "robustness.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -46,9 +51,10 @@ for s in "${S[@]}"; do
     read -r w it dt st <<< "$c"
     d="$out/${s}_w${w}_it${it}_dt${dt}_x${st}"
     rm -rf "$d"
-    echo "== $s W $w, $it iterations, dt $dt, strength x$st" >&2
+    echo "== $s W $w, $it iterations, dt $dt, strength x$st${flags:+, $flags}" >&2
+    # shellcheck disable=SC2086  # --flags is a list of words
     "$bin" "$s" --seconds "$seconds" --no-render --fps 60 --out "$d" --quickstep-w "$w" \
-        --quickstep-iterations "$it" --dt "$dt" --strength "$st" >/dev/null 2>"$d.log" || true
+        --quickstep-iterations "$it" --dt "$dt" --strength "$st" $flags >/dev/null 2>"$d.log" || true
     row=$(python3 - "$d/summary.json" "$bound" <<'PY'
 import json, math, sys
 try:
@@ -70,7 +76,7 @@ PY
   done
 done
 {
-  echo "# Robustness matrix ($seconds s, default method; bound: no body faster than $bound m/s, finite, no error)"
+  echo "# Robustness matrix ($seconds s, default method${flags:+, $flags}; bound: no body faster than $bound m/s, finite, no error)"
   echo
   echo "| scene | W | iterations | dt_r (s) | strength | peak speed (m/s) | final KE (J) | sub-steps/frame | error | verdict |"
   echo "|---|---|---|---|---|---|---|---|---|---|"
