@@ -78,6 +78,25 @@ TEST_CASE("falling_magnet without magnetism comes to rest: rolling resistance on
   CHECK(r.last.escaped == 0);           // none beyond 1 m (17 without resistance)
 }
 
+TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is thrown far",
+          "[stability][falling_magnet]") {
+  // The paper's Fig. 5 on our side (issue #12 asks a contrast test; Kim 2018 does not fail
+  // here, so it is stated, not asserted): 1032 balls, 1 s, the scene's defaults (eq. 4,
+  // softening 2.5 mm, up to 8 motion sub-steps). Measured (every 5 steps): 648 held, 939
+  // attached, none beyond 1 m, fastest ball 8.1 m/s (as the magnet lands), 1.6 m/s in the
+  // last 0.2 s; at 2 s, over 1032…1029 balls, 0–2 beyond 1 m. Kim 2018 (its magnetization,
+  // the classic force), 1 s, frames at 60 fps: 596 held, 941 attached, none beyond 1 m,
+  // fastest 5.6 m/s: it does not fail here (README).
+  const auto r = run_scene("falling_magnet", Method::OursRealigned, 1.0, 0.2);
+  INFO("held " << r.last.held << ", attached " << r.last.attached << ", escaped "
+               << r.last.escaped << ", fastest " << r.max_speed << " m/s, in the last 0.2 s "
+               << r.tail_max_speed << " m/s");
+  REQUIRE_FALSE(r.failed);
+  CHECK(r.last.held >= 400);     // measured 648
+  CHECK(r.last.escaped <= 6);    // measured 0 (issue #12 found 52 beyond 1 m at 2 s)
+  CHECK(r.max_speed < 20.0);     // m/s; 2.5x the measured 8.1
+}
+
 TEST_CASE("sakura_tree: balls land on the branch-end magnets and stay without being flung",
           "[stability][sakura_tree]") {
   // 500 balls (23 × 23 sheet over the tree), 0.6 s: they reach the tips at ≈ 0.16 s. Measured
