@@ -86,7 +86,7 @@ TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is
   // attached, none beyond 1 m, fastest ball 8.1 m/s (as the magnet lands), 1.6 m/s in the
   // last 0.2 s; at 2 s, over 1032…1029 balls, 0–2 beyond 1 m. Kim 2018 (its magnetization,
   // the classic force), 1 s, frames at 60 fps: 596 held, 941 attached, none beyond 1 m,
-  // fastest 5.6 m/s: it does not fail here (README).
+  // fastest 5.6 m/s: it does not scatter the balls as the paper's Fig. 5b shows (README).
   // one magnetics thread, as the sakura_tree W 1.0 test (2 threads: 259 s under CTest -j2)
   const auto r = run_scene("falling_magnet", Method::OursRealigned, 1.0, 0.2, 0, 1.0, 0.0,
                            [](engine::SceneDesc& d) { d.options.threads = 1; });
