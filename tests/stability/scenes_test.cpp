@@ -87,9 +87,7 @@ TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is
   // last 0.2 s; at 2 s, over 1032…1029 balls, 0–2 beyond 1 m. Kim 2018 (its magnetization,
   // the classic force), 1 s, frames at 60 fps: 596 held, 941 attached, none beyond 1 m,
   // fastest 5.6 m/s: it does not scatter the balls as the paper's Fig. 5b shows (README).
-  // one magnetics thread, as the sakura_tree W 1.0 test (2 threads: 259 s under CTest -j2)
-  const auto r = run_scene("falling_magnet", Method::OursRealigned, 1.0, 0.2, 0, 1.0, 0.0,
-                           [](engine::SceneDesc& d) { d.options.threads = 1; });
+  const auto r = run_scene("falling_magnet", Method::OursRealigned, 1.0, 0.2);
   INFO("held " << r.last.held << ", attached " << r.last.attached << ", escaped "
                << r.last.escaped << ", fastest " << r.max_speed << " m/s, in the last 0.2 s "
                << r.tail_max_speed << " m/s");
@@ -123,22 +121,16 @@ TEST_CASE("sakura_tree with QuickStep W 1.0: bounded pairs keep the balls on the
   // two radii summed (bounded pairs), so an overlap cannot raise the pull. Measured here
   // (every 5 steps): with them fastest ball 7.5 m/s, 6 beyond 0.5 m, 215 held; without
   // them 149 m/s and 53 beyond 0.5 m.
-  // One magnetics thread (the outcome does not depend on it): CTest runs two tests at once
-  // on 2 cores, and two 2-thread runs stalled each other's OpenMP barriers (130 s against
-  // 11 s alone).
-  auto point_pairs = [](engine::SceneDesc& d) {
-    d.options.quickstep_w = 1.0;
-    d.options.magnetics.field.bounded_pairs = false;
-    d.options.threads = 1;
+  auto w_one = [](bool bounded) {
+    return [bounded](engine::SceneDesc& d) {
+      d.options.quickstep_w = 1.0;
+      d.options.magnetics.field.bounded_pairs = bounded;
+    };
   };
-  const auto off = run_scene("sakura_tree", Method::OursRealigned, 0.6, 0.1, 500, 1.0, 0.0, point_pairs);
+  const auto off = run_scene("sakura_tree", Method::OursRealigned, 0.6, 0.1, 500, 1.0, 0.0, w_one(false));
   INFO("point pairs: fastest " << off.max_speed << " m/s, escaped " << off.last.escaped);
   CHECK((off.failed || off.max_speed > 50.0));  // m/s; measured 149
-  const auto on = run_scene("sakura_tree", Method::OursRealigned, 0.6, 0.1, 500, 1.0, 0.0,
-                            [](engine::SceneDesc& d) {
-                              d.options.quickstep_w = 1.0;
-                              d.options.threads = 1;
-                            });
+  const auto on = run_scene("sakura_tree", Method::OursRealigned, 0.6, 0.1, 500, 1.0, 0.0, w_one(true));
   INFO("bounded pairs: fastest " << on.max_speed << " m/s, escaped " << on.last.escaped
                                  << ", held " << on.last.held);
   REQUIRE_FALSE(on.failed);
