@@ -82,6 +82,9 @@ void check_options(const SimOptions& o, const Vec3& H0) {
                                 " cores), got " + std::to_string(o.threads));
   if (!(o.rolling_friction >= 0 && std::isfinite(o.rolling_friction)))
     fail("options.rolling_friction", "must be >= 0 and finite (m) (got " + fmt(o.rolling_friction) + ")");
+  if (!(o.rolling_friction_bodies >= 0 && std::isfinite(o.rolling_friction_bodies)))
+    fail("options.rolling_friction_bodies",
+         "must be >= 0 and finite (m) (got " + fmt(o.rolling_friction_bodies) + ")");
   if (o.max_substeps < 1 || o.max_substeps > 64)
     fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
   if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))

@@ -120,6 +120,8 @@ TEST_CASE("scene_file: bad files fail with the file and the JSON path", "[scene_
              Contains("options.magnetics.tol: must be a number"));
   CHECK_THAT(error_of(R"({"options": {"friction": -1}, "bodies": []})"),
              Contains("options.friction: must be >= 0"));
+  CHECK_THAT(error_of(R"({"options": {"rolling_friction_bodies": -1e-3}, "bodies": []})"),
+             Contains("options.rolling_friction_bodies: must be >= 0"));
   CHECK_THAT(error_of(R"({"bodies": [{"moments": [{"volume": 1e-6, "permanent": true, "Ms": 3}], "type": "static"}]})"),
              Contains("bodies[0].moments[0].Ms: only for induced moments"));
   CHECK_THAT(error_of(R"({"bodies": [{"moments": [{"Ms": 3}], "type": "static"}]})"),

@@ -115,7 +115,8 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   // a run whose options differ from the scene's in many places
   const std::string out = tmp_dir("replay");
   const Result r = run_scene("balls_up --count 27 --steps 50 --no-render --space hash --dt-m 8e-8 --tol 3e-5 "
-                             "--quickstep-iterations 40 --quickstep-w 1.2 --rolling-friction 1e-4 --max-substeps 2 "
+                             "--quickstep-iterations 40 --quickstep-w 1.2 --rolling-friction 1e-4 --rolling-friction-bodies 2e-4 "
+                             "--max-substeps 2 "
                              "--substep-load off "
                              "--method anderson --threads 1 --out " + out);
   INFO(r.out);
@@ -125,6 +126,7 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   CHECK(summary["options"]["magnetics"]["dt"] == 8e-8);
   CHECK(summary["options"]["method"] == "anderson");
   CHECK(summary["options"]["substep_load"] == false);
+  CHECK(summary["options"]["rolling_friction_bodies"] == 2e-4);
   // the registry scene's bodies with the summary's options, read as a scene file
   magsim::scenes::SceneParams p;
   p.count = 27;

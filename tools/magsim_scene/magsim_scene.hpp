@@ -63,6 +63,7 @@ struct Args {
   double substep_reach = 0.0;
   std::string substep_load;
   double rolling_friction = 0.0;
+  double rolling_friction_bodies = 0.0;
   double quickstep_w = 0.0;
   double dt = 0.0;
   std::string bounded_pairs;

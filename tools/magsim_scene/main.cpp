@@ -90,6 +90,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
   if (app.count("--substep-load")) s.options.substep_load = on_off("--substep-load", a.substep_load);
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
+  if (app.count("--rolling-friction-bodies")) s.options.rolling_friction_bodies = a.rolling_friction_bodies;
   if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
   if (app.count("--dt")) s.options.dt = a.dt;
   if (app.count("--bounded-pairs"))
@@ -190,6 +191,9 @@ int main(int argc, char** argv) {
                  "a h^2 <= reach * r_min per sub-step (default on)");
   app.add_option("--rolling-friction", a.rolling_friction,
                  "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--rolling-friction-bodies", a.rolling_friction_bodies,
+                 "the same between two dynamic bodies (a ball rolling on a ball), rho (m) (0 = none; default: the scene's)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
       ->check(CLI::Range(1e-6, 1.999999));
