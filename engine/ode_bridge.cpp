@@ -224,8 +224,9 @@ struct OdeBridge::Impl {
     }
     surface.soft_erp = o.erp;
     surface.soft_cfm = o.cfm;
-    // rolling resistance (contacts with the ground and static bodies, see collide): the two
-    // rolling rows and the spinning row carry a torque of at most ρ·N (dContactRolling with
+    // rolling resistance (contacts with the ground and static bodies: rolling_friction;
+    // between two dynamic bodies: rolling_friction_bodies; see collide): the two rolling rows
+    // and the spinning row carry a torque of at most ρ·N (dContactRolling with
     // dContactApprox1: limits ∝ the normal force)
     auto with_rolling = [&](double rho) {
       dSurfaceParameters s = surface;
