@@ -395,14 +395,14 @@ SceneDesc sakura_tree(const SceneParams& p) {
   // rolling resistance between two balls too (the same ρ): a ball hanging on one neighbour
   // at a tip rolled to and fro on it without loss (500 balls, 1 s after landing: 0.1–1.7
   // m/s and 200–800 rad/s with a 30 ms period, traced per step), and the tip clusters kept
-  // rattling (2 s: 25–31 tip balls moving > 1 mm between 60 fps frames, most of the final
-  // kinetic energy spin). 2 s, 2500…2497 balls: tip balls moving > 1 mm between frames 6
-  // on average; fastest ball at 2 s 0.34, 0.55, 0.39, 0.35 m/s against 0.56–0.82; final KE
-  // 0.0055–0.0075 J (spin 0.0006) against 0.074–0.10 (spin 0.065–0.091; 2500, 2496, 2495
-  // balls); beyond 0.5 m 4, 1, 4, 3 against 0, 3, 2, 3: balls bent outward past a tip
-  // before they touch anything (README). Cost: T_i+T_f+T_r per frame 85.9 against 69.0 ms
-  // (1 s, 1 thread, 2 interleaved pairs; QuickStep 17 → 32 ms). falling_magnet does not
-  // take it: there its heap, stickier, slid later (README).
+  // rattling (2 s: 24.5–30.7 tip balls on average moving > 1 mm between 60 fps frames in
+  // the last second, most of the final kinetic energy spin). 2 s, 2500…2497 balls: 6.3,
+  // 6.2, 15.9, 10.9 such balls; fastest ball at 2 s 0.34, 0.55, 0.39, 0.35 m/s against
+  // 0.56–0.82; final KE 0.0055–0.0075 J (spin 0.0006) against 0.074–0.10 (spin
+  // 0.065–0.091; 2500, 2496, 2495 balls); beyond 0.5 m 4, 1, 4, 3 against 0, 3, 2, 3:
+  // balls bent outward past a tip before they touch anything (README). Cost: T_i+T_f+T_r
+  // per frame 85.9 against 69.0 ms (1 s, 1 thread, 2 interleaved pairs; QuickStep 17 → 32
+  // ms). falling_magnet does not take it: there its heap, stickier, slid later (README).
   s.options.rolling_friction_bodies = kRollingCoefficient * r;
   s.camera.eye = Eigen::Vector3f(0.55f, -0.65f, 0.45f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.17f);
