@@ -44,6 +44,13 @@ void check_at_most(const std::string& where, double magnitude, double max, const
                     " (engine/limits.hpp: beyond it the rigid-body or magnetics arithmetic overflows)");
 }
 
+// >= 0 and finite; `unit` (e.g. "m") is named in the message when given
+void check_non_negative(const std::string& where, double x, const char* unit = nullptr) {
+  if (!(x >= 0 && std::isfinite(x)))
+    fail(where, std::string("must be >= 0 and finite") + (unit ? std::string(" (") + unit + ")" : "") +
+                    " (got " + fmt(x) + ")");
+}
+
 std::string body_where(int i, const std::string& name) {
   return "body " + std::to_string(i) + " '" + name + "'";
 }
@@ -52,24 +59,20 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (!(o.dt > 0 && o.dt <= 0.1)) fail("options.dt", "must be in (0, 0.1] s (got " + fmt(o.dt) + ")");
   if (!finite(o.gravity)) fail("options.gravity", "must be finite (got " + fmt(o.gravity) + ")");
   check_at_most("options.gravity", o.gravity.stableNorm(), limits::kMaxGravity, "m/s^2");
-  if (!(o.friction >= 0 && std::isfinite(o.friction)))
-    fail("options.friction", "must be >= 0 and finite (got " + fmt(o.friction) + ")");
+  check_non_negative("options.friction", o.friction);
   if (!(o.restitution >= 0 && o.restitution <= 1))
     fail("options.restitution", "must be in [0, 1] (got " + fmt(o.restitution) + ")");
   if (!(o.erp >= 0 && o.erp <= 1)) fail("options.erp", "must be in [0, 1] (got " + fmt(o.erp) + ")");
-  if (!(o.cfm >= 0 && std::isfinite(o.cfm))) fail("options.cfm", "must be >= 0 and finite (got " + fmt(o.cfm) + ")");
+  check_non_negative("options.cfm", o.cfm);
   if (o.quickstep_iterations < 1)
     fail("options.quickstep_iterations", "must be >= 1 (got " + std::to_string(o.quickstep_iterations) + ")");
   if (!(o.quickstep_w > 0 && o.quickstep_w < 2))
     fail("options.quickstep_w", "must be in (0, 2) (got " + fmt(o.quickstep_w) + ")");
   if (o.max_contacts < 1 || o.max_contacts > 64)
     fail("options.max_contacts", "must be in [1, 64] (got " + std::to_string(o.max_contacts) + ")");
-  if (!(o.linear_damping >= 0 && std::isfinite(o.linear_damping)))
-    fail("options.linear_damping", "must be >= 0 and finite (got " + fmt(o.linear_damping) + ")");
-  if (!(o.angular_damping >= 0 && std::isfinite(o.angular_damping)))
-    fail("options.angular_damping", "must be >= 0 and finite (got " + fmt(o.angular_damping) + ")");
-  if (!(o.surface_layer >= 0 && std::isfinite(o.surface_layer)))
-    fail("options.surface_layer", "must be >= 0 and finite (got " + fmt(o.surface_layer) + ")");
+  check_non_negative("options.linear_damping", o.linear_damping);
+  check_non_negative("options.angular_damping", o.angular_damping);
+  check_non_negative("options.surface_layer", o.surface_layer);
   if (!(o.max_correcting_velocity >= 0))
     fail("options.max_correcting_velocity", "must be >= 0 (0 = unlimited) (got " + fmt(o.max_correcting_velocity) + ")");
   if (!std::isfinite(o.contact_margin))
@@ -80,11 +83,8 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (o.threads > 4 * cores)
     fail("options.threads", "at most " + std::to_string(4 * cores) + " (4 x the " + std::to_string(cores) +
                                 " cores), got " + std::to_string(o.threads));
-  if (!(o.rolling_friction >= 0 && std::isfinite(o.rolling_friction)))
-    fail("options.rolling_friction", "must be >= 0 and finite (m) (got " + fmt(o.rolling_friction) + ")");
-  if (!(o.rolling_friction_bodies >= 0 && std::isfinite(o.rolling_friction_bodies)))
-    fail("options.rolling_friction_bodies",
-         "must be >= 0 and finite (m) (got " + fmt(o.rolling_friction_bodies) + ")");
+  check_non_negative("options.rolling_friction", o.rolling_friction, "m");
+  check_non_negative("options.rolling_friction_bodies", o.rolling_friction_bodies, "m");
   if (o.max_substeps < 1 || o.max_substeps > 64)
     fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
   if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))
@@ -268,8 +268,7 @@ Model compile_model(const SceneDesc& scene) {
   m.name = scene.name;
   m.description = scene.description;
   m.modelling_level = scene.modelling_level;
-  if (!(scene.escape_radius >= 0 && std::isfinite(scene.escape_radius)))
-    fail("escape_radius", "must be >= 0 and finite (got " + fmt(scene.escape_radius) + ")");
+  check_non_negative("escape_radius", scene.escape_radius);
   m.escape_radius = scene.escape_radius;
   m.nbody = static_cast<int>(scene.bodies.size());
 
