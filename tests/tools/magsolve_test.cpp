@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
@@ -16,7 +15,7 @@ using Result = magsim::test::CommandResult;
 Result run(const std::string& args) { return magsim::test::run_command(MAGSOLVE_BIN, args); }
 
 std::string write_tmp(const std::string& name, const std::string& text) {
-  const std::string path = "/tmp/magsolve_test_" + std::to_string(getpid()) + "_" + name;
+  const std::string path = magsim::test::scratch("magsolve_" + name);
   std::ofstream(path) << text;
   return path;
 }

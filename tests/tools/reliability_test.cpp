@@ -10,7 +10,6 @@
 #include <fstream>
 #include <iterator>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
@@ -22,7 +21,7 @@ CommandResult solve(const std::string& args) { return magsim::test::run_command(
 std::string input(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tests/tools/inputs/" + name; }
 std::string example(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tools/examples/" + name; }
 
-std::string tmp(const std::string& name) { return "/tmp/reliability_test_" + std::to_string(getpid()) + "_" + name; }
+std::string tmp(const std::string& name) { return magsim::test::scratch("reliability_" + name); }
 
 std::size_t lines(const std::string& s) {
   std::size_t n = 0;

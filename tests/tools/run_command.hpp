@@ -6,8 +6,11 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <sys/wait.h>
+#include <system_error>
+#include <unistd.h>
 
 namespace magsim::test {
 
@@ -29,5 +32,27 @@ inline CommandResult run_command(const std::string& program, const std::string& 
   r.code = WIFEXITED(st) ? WEXITSTATUS(st) : 128;
   return r;
 }
+
+/// This test process's folder for the files and output folders it hands to the programs:
+/// under the system's temporary directory ($TMPDIR, else /tmp), made on first use and
+/// removed with everything in it when the process exits, so repeated runs of the suite
+/// leave nothing behind (a crashed test's files stay, to look at).
+inline const std::filesystem::path& scratch_dir() {
+  struct Dir {
+    std::filesystem::path path;
+    Dir() : path(std::filesystem::temp_directory_path() / ("magsim_test_" + std::to_string(getpid()))) {
+      std::filesystem::create_directories(path);
+    }
+    ~Dir() {
+      std::error_code ec;  // best effort: a destructor at exit must not throw
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+/// scratch_dir()/name, as a string to put on a command line.
+inline std::string scratch(const std::string& name) { return (scratch_dir() / name).string(); }
 
 }  // namespace magsim::test

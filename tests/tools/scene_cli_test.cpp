@@ -13,7 +13,6 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 namespace {
 
@@ -22,7 +21,7 @@ using Result = magsim::test::CommandResult;
 Result run_scene(const std::string& args) { return magsim::test::run_command(MAGSIM_SCENE_BIN, args); }
 
 std::string tmp_dir(const std::string& name) {
-  return "/tmp/scene_cli_test_" + std::to_string(getpid()) + "_" + name;
+  return magsim::test::scratch("scene_cli_" + name);
 }
 
 }  // namespace
