@@ -228,10 +228,11 @@ TEST_CASE("step: the engine's thread count does not leak into the caller's OpenM
   omp_set_num_threads(before);
 }
 
-TEST_CASE("step: only bodies in contact split a frame into sub-steps", "[step][substeps]") {
+TEST_CASE("step: only bodies touching a body split a frame into sub-steps", "[step][substeps]") {
   // SimOptions::max_substeps: n = ⌈(|v| + |Δv|) Δt_r / (reach · r)⌉ over the bodies that
-  // touched something in the last frame. Two balls at 4 m/s: one slides on the frictionless
-  // ground (n = ⌈4 · 1e-3 / (0.25 · 5e-3)⌉ = 4), one flies 1 m up and splits nothing.
+  // touched another body in the last frame. Balls at 4 m/s on the frictionless ground:
+  // two sliding side by side, touching, split in n = ⌈4 · 1e-3 / (0.25 · 5e-3)⌉ = 4; one
+  // sliding alone does not (the ground plane cannot be tunnelled), nor one flying 1 m up.
   auto ball = [](const char* name, const Vec3& p, const Vec3& v) {
     BodyDesc b = iron_ball(name, p);
     b.moments.clear();  // mechanics only
@@ -242,9 +243,10 @@ TEST_CASE("step: only bodies in contact split a frame into sub-steps", "[step][s
   s.options.threads = 1;
   s.options.friction = 0.0;
   s.options.max_substeps = 8;
-  s.options.gravity = Vec3::Zero();  // the sliding ball keeps 4 m/s, the flying one its height
+  s.options.gravity = Vec3::Zero();  // the sliding balls keep 4 m/s, the flying one its height
+  const Vec3 v(4, 0, 0);
   SECTION("a ball flying free: one step per frame") {
-    s.bodies = {ball("flying", Vec3(0, 0, 1.0), Vec3(4, 0, 0))};
+    s.bodies = {ball("flying", Vec3(0, 0, 1.0), v)};
     engine::Simulation sim(s);
     for (int k = 0; k < 20; ++k) {
       sim.step();
@@ -252,21 +254,31 @@ TEST_CASE("step: only bodies in contact split a frame into sub-steps", "[step][s
       CHECK(sim.last_profile().substeps == 1);
     }
   }
-  SECTION("the same ball sliding on the ground: four") {
-    s.bodies = {ball("sliding", Vec3(0, 0, kR), Vec3(4, 0, 0))};
+  SECTION("the same ball sliding on the ground: one") {
+    s.bodies = {ball("sliding", Vec3(0, 0, kR), v)};
+    engine::Simulation sim(s);
+    for (int k = 0; k < 20; ++k) {
+      sim.step();
+      REQUIRE(sim.last_profile().contacts >= 1);
+      CHECK(sim.last_profile().substeps == 1);
+    }
+    CHECK(sim.body_velocity(0).x() == Approx(4.0).epsilon(1e-6));
+  }
+  SECTION("two balls touching each other, sliding on the ground: four") {
+    s.bodies = {ball("a", Vec3(0, 0, kR), v), ball("b", Vec3(0, 2 * kR, kR), v)};
     engine::Simulation sim(s);
     sim.step();  // the first frame has no contacts from a frame before it
     CHECK(sim.last_profile().substeps == 1);
     for (int k = 0; k < 20; ++k) {
       sim.step();
-      REQUIRE(sim.last_profile().contacts >= 1);
+      REQUIRE(sim.last_profile().contacts >= 3);  // a–b and each on the ground
       CHECK(sim.last_profile().substeps == 4);
     }
     CHECK(sim.body_velocity(0).x() == Approx(4.0).epsilon(1e-6));
   }
-  SECTION("both: the flying ball does not split the sliding one's frames further") {
-    s.bodies = {ball("sliding", Vec3(0, 0, kR), Vec3(4, 0, 0)),
-                ball("flying", Vec3(0, 1.0, 1.0), Vec3(0, 30, 0))};  // 30 m/s: 24 alone
+  SECTION("and a ball flying at 30 m/s does not split their frames further") {
+    s.bodies = {ball("a", Vec3(0, 0, kR), v), ball("b", Vec3(0, 2 * kR, kR), v),
+                ball("flying", Vec3(0, 1.0, 1.0), Vec3(0, 30, 0))};  // 24 if it counted
     engine::Simulation sim(s);
     sim.step();
     for (int k = 0; k < 20; ++k) {
