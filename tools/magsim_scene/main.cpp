@@ -180,8 +180,8 @@ int main(int argc, char** argv) {
                  "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) | zeeman-total (eq. 4 as the gradient "
                  "of the system's Zeeman energy: conservative) (default: the scene's, method)");
   app.add_option("--max-substeps", a.max_substeps,
-                 "most rigid sub-steps per frame; a frame is split when bodies in contact move fast or are "
-                 "pressed hard by the magnetic force (1 = never; default: the scene's)")
+                 "most rigid sub-steps per frame; a frame is split when bodies touching each other move fast or bodies "
+                 "in contact are pressed hard by the magnetic force (1 = never; default: the scene's)")
       ->check(CLI::Range(1, 64));
   app.add_option("--substep-reach", a.substep_reach,
                  "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
