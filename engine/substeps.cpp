@@ -3,13 +3,13 @@
 // A 4 g ball pulled at 10⁴ m/s² covers three radii in one 1 ms step; contacts, speculative
 // margins and the magnetization all see it only at the step's ends. Splitting the frame
 // bounds how far any body moves between two looks. Two terms, over the bodies that touched
-// something in the last frame, the motion term over those that touched another body (see
-// choose_substeps) (a ball in free flight moves ballistically whatever the step,
+// something in the last frame; a ball in free flight moves ballistically whatever the step,
 // and one ball thrown off at 8 m/s would otherwise split every frame of the whole scene for
-// as long as it flies: falling_magnet, ≤ 8 sub-steps, 6.5 per frame on average over 0.6 s
+// as long as it flies (falling_magnet, ≤ 8 sub-steps, 6.5 per frame on average over 0.6 s
 // counting every body, 2.2 counting those in contact; issue #12):
-//  - motion: the velocity the body had and its change over the last frame (contact forces
-//    included), (|v| + |Δv|) h ≤ reach · r_min;
+//  - motion, over the bodies that touched another body (not only the ground plane: see
+//    choose_substeps): the velocity the body had and its change over the last frame
+//    (contact forces included), (|v| + |Δv|) h ≤ reach · r_min;
 //  - load (SimOptions::substep_load): the magnetic acceleration a = |F|/m the contacts hold,
 //    a h² ≤ reach · r_min. A pile resting against a magnet does not move, but QuickStep
 //    leaves a fraction ε of each contact force unbalanced, and the body sinks ε a h² into its

@@ -159,7 +159,6 @@ TEST_CASE("magsim-scene NAME --write-scene FILE: the file runs to the registry r
   CHECK(jb["source"] == file);
   CHECK(ja["state_hash"] == jb["state_hash"]);
   CHECK(ja["options"] == jb["options"]);
-  std::remove(file.c_str());
 }
 
 TEST_CASE("tools/ensemble.py: one row per perturbed run, each from its summary.json, and the spread", "[tools]") {
