@@ -89,6 +89,9 @@ void check_options(const SimOptions& o, const Vec3& H0) {
     fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
   if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))
     fail("options.substep_reach", "must be > 0 and finite (got " + fmt(o.substep_reach) + ")");
+  if (o.balance_magnetic_torque && !o.reaction_symmetric_forces)
+    fail("options.balance_magnetic_torque",
+         "needs reaction_symmetric_forces (it removes the torque those forces leave)");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
   mag::DynamicsOptions d = o.magnetics;

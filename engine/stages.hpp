@@ -39,5 +39,14 @@ void compute_magnetic_forces(const Model& model, const mag::MomentSet& set, Work
 /// moments as a body torque. Wakes a sleeping body whose magnetic load changed.
 void apply_magnetic_forces(const Model& model, const mag::MomentSet& set, Workspace* ws,
                            OdeBridge* ode);
+/// SimOptions::balance_magnetic_torque: cancels the net torque the reaction-symmetric
+/// Zeeman forces leave (ws->balance_force, added to ws->body_force; apply_forces.cpp).
+void balance_magnetic_torque(const Model& model, const mag::MomentSet& set, Workspace* ws,
+                             const OdeBridge* ode);
+/// The least correction δF_b (Σ_b |δF_b|²/w_b minimal) with Σ δF_b = 0 and
+/// Σ_b x_b × δF_b = −L; bodies with w_b = 0 take none. The part of L along a line through
+/// every weighted body cannot be cancelled by forces and stays.
+void torque_balance_forces(const std::vector<Vec3>& x, const std::vector<double>& w, const Vec3& L,
+                           std::vector<Vec3>* dF);
 
 }  // namespace magsim::engine

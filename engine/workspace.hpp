@@ -20,6 +20,11 @@ struct Workspace {
   std::vector<Vec3> body_torque;
   /// (nbody) net magnetic force when the body was last awake (auto-disable wake-up)
   std::vector<Vec3> body_force_awake;
+  /// (nbody) SimOptions::balance_magnetic_torque: the correction per body (N; empty when
+  /// not applied this step), and its scratch (positions, weights)
+  std::vector<Vec3> balance_force;
+  std::vector<Vec3> balance_x;
+  std::vector<double> balance_w;
   State sub_prev;                 ///< the state after the last sub-step (energy audit)
   State next;                     ///< the state being computed; swapped in when it checks out
   EnergyAudit audit;              ///< the energy audit being computed, committed with next

@@ -93,6 +93,7 @@ json to_json(const SimOptions& o) {
               {"contact_margin", o.contact_margin},
               {"threads", o.threads},
               {"reaction_symmetric_forces", o.reaction_symmetric_forces},
+              {"balance_magnetic_torque", o.balance_magnetic_torque},
               {"force_model", engine::force_choice_name(o.force_model)},
               {"max_substeps", o.max_substeps},
               {"substep_reach", o.substep_reach},
@@ -149,7 +150,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   r.keys(j, path, {"method", "dt", "gravity", "ground", "friction", "restitution", "erp", "cfm",
                    "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
-                   "threads", "reaction_symmetric_forces", "field_solver", "bh_theta", "bh_threshold",
+                   "threads", "reaction_symmetric_forces", "balance_magnetic_torque", "field_solver", "bh_theta", "bh_threshold",
                    "magnetics", "force_model", "max_substeps", "substep_reach", "substep_load", "rolling_friction",
                    "rolling_friction_bodies", "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size",
                    "bh_order",
@@ -190,6 +191,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
     if (!(o->quickstep_w > 0 && o->quickstep_w < 2)) r.fail(p, "must be in (0, 2) (got " + JsonReader::fmt(o->quickstep_w) + ")");
   });
   if_present(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
+  if_present(j, "balance_magnetic_torque", path, [&](const json& v, const std::string& p) { o->balance_magnetic_torque = r.boolean(v, p); });
   mag::FieldOptions& f = o->magnetics.field;
   if_present(j, "field_solver", path, [&](const json& v, const std::string& p) {
     const std::string s = r.string(v, p);

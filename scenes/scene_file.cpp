@@ -19,7 +19,7 @@
 //       "max_contacts": 4, "space": "sap" | "hash" | "simple", "auto_disable": false,
 //       "linear_damping": 0, "angular_damping": 0, "surface_layer": 0,
 //       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
-//       "reaction_symmetric_forces": false,
+//       "reaction_symmetric_forces": false, "balance_magnetic_torque": false,
 //       "force_model": "method" | "zeeman" | "classic" | "zeeman-total",
 //       "max_substeps": 1,
 //       "substep_reach": 0.25, "rolling_friction": 0, "quickstep_w": 1.3,

@@ -82,6 +82,12 @@ TEST_CASE("model: other invalid inputs are rejected with the field named", "[mod
     s.options.dt = 0;
     CHECK_THAT(compile_error(s), Contains("options.dt"));
   }
+  SECTION("torque balance without reaction-symmetric forces") {
+    s.options.balance_magnetic_torque = true;
+    CHECK_THAT(compile_error(s), Contains("options.balance_magnetic_torque: needs reaction_symmetric_forces"));
+    s.options.reaction_symmetric_forces = true;
+    CHECK(compile_error(s).empty());
+  }
   SECTION("magnetics options") {
     s.options.magnetics.dt = 1e-3;
     CHECK_THAT(compile_error(s), Contains("options.magnetics") && Contains("dt"));

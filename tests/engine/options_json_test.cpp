@@ -48,6 +48,7 @@ SimOptions all_changed() {
   f.bh_near_float = false;
   f.bh_far_float = false;
   o.reaction_symmetric_forces = true;
+  o.balance_magnetic_torque = true;
   o.force_model = engine::ForceChoice::Classic;
   o.dt = 5e-4;
   o.max_substeps = 6;
@@ -106,6 +107,7 @@ void check_equal(const SimOptions& a, const SimOptions& b) {
   CHECK(fa.bh_near_float == fb.bh_near_float);
   CHECK(fa.bh_far_float == fb.bh_far_float);
   CHECK(a.reaction_symmetric_forces == b.reaction_symmetric_forces);
+  CHECK(a.balance_magnetic_torque == b.balance_magnetic_torque);
   CHECK(a.force_model == b.force_model);
   CHECK(a.dt == b.dt);
   CHECK(a.max_substeps == b.max_substeps);

@@ -101,6 +101,9 @@ TEST_CASE("magsim-scene refuses bad ODE flags with a message and exit code 1", "
       {"balls_up --steps 1 --no-render --force-model total", "--force-model"},
       {"balls_up --steps 1 --no-render --substep-load maybe", "--substep-load"},
       {"balls_up --steps 1 --no-render --bounded-pairs yes", "--bounded-pairs"},
+      {"balls_up --steps 1 --no-render --balance-magnetic-torque yes", "--balance-magnetic-torque"},
+      // balls_up's forces are not reaction-symmetric: the balance has nothing to balance
+      {"balls_up --steps 1 --no-render --balance-magnetic-torque on", "needs reaction_symmetric_forces"},
   };
   for (const Case& c : cases) {
     const Result r = run_scene(c.args);

@@ -62,6 +62,7 @@ struct Args {
   int max_substeps = 0;
   double substep_reach = 0.0;
   std::string substep_load;
+  std::string balance_magnetic_torque;
   double rolling_friction = 0.0;
   double rolling_friction_bodies = 0.0;
   double quickstep_w = 0.0;

@@ -89,6 +89,8 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
   if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
   if (app.count("--substep-load")) s.options.substep_load = on_off("--substep-load", a.substep_load);
+  if (app.count("--balance-magnetic-torque"))
+    s.options.balance_magnetic_torque = on_off("--balance-magnetic-torque", a.balance_magnetic_torque);
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
   if (app.count("--rolling-friction-bodies")) s.options.rolling_friction_bodies = a.rolling_friction_bodies;
   if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
@@ -189,6 +191,10 @@ int main(int argc, char** argv) {
   app.add_option("--substep-load", a.substep_load,
                  "on | off: also split a frame by the magnetic acceleration a of bodies in contact, "
                  "a h^2 <= reach * r_min per sub-step (default on)");
+  app.add_option("--balance-magnetic-torque", a.balance_magnetic_torque,
+                 "on | off: cancel the net torque that eq. 4's reaction-symmetric forces leave (they sum to "
+                 "zero, their torques do not), by the least forces that do, where the torque arises; needs "
+                 "reaction-symmetric forces (default: the scene's, off in every registry scene)");
   app.add_option("--rolling-friction", a.rolling_friction,
                  "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
       ->check(CLI::NonNegativeNumber);
