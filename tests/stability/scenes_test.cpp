@@ -98,6 +98,34 @@ TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is
   CHECK(r.max_speed < 20.0);     // m/s; 2.5x the measured 8.1
 }
 
+TEST_CASE("falling_magnet at 3x strength with 40 QuickStep iterations: the torque balance stops the runaway",
+          "[stability][falling_magnet][torque_balance]") {
+  // eq. 4's reaction-symmetric forces sum to zero but leave a net torque (about 1 N·m in the
+  // 1032-ball scene at ×3, apply_forces.cpp); with 40 iterations it spins and rolls the magnet
+  // and its heap across the floor while the magnetic work keeps growing (1031 balls, 2 s: KE
+  // 17.1 J, 248 beyond 1 m). 600 balls, 0.5 s, measured (every 5 steps): without the balance
+  // KE up to 11.6 J in the last 0.1 s, with it 0.10 J (1 and 0 beyond 1 m; the landing's
+  // fastest ball 18.7 and 21.4 m/s either way, so that is not asserted). 600, 599, 598 balls
+  // at 0.5 s (20 fps): KE 11.6, 10.7, 5.7 J without, 0.09, 0.21, 0.30 with; at 1 s 166, 154,
+  // 88 balls beyond 1 m without, 2, 4, 6 with.
+  auto run = [](bool balance) {
+    return run_scene("falling_magnet", Method::OursRealigned, 0.5, 0.1, 600, 3.0, 0.0,
+                     [balance](engine::SceneDesc& d) {
+                       d.options.quickstep_iterations = 40;
+                       d.options.balance_magnetic_torque = balance;
+                     });
+  };
+  const auto off = run(false);
+  const auto on = run(true);
+  INFO("KE in the last 0.1 s: without the balance " << off.tail_max_ke << " J, with it " << on.tail_max_ke
+                                                     << " J; escaped " << off.last.escaped << ", " << on.last.escaped
+                                                     << "; fastest " << off.max_speed << ", " << on.max_speed << " m/s");
+  REQUIRE_FALSE(off.failed);
+  REQUIRE_FALSE(on.failed);
+  CHECK(off.tail_max_ke > 2.0);  // J; measured 11.6
+  CHECK(on.tail_max_ke < 1.0);   // J; measured 0.10
+}
+
 TEST_CASE("sakura_tree: balls land on the branch-end magnets and stay without being flung",
           "[stability][sakura_tree]") {
   // 500 balls (23 × 23 sheet over the tree), 0.6 s: they reach the tips at ≈ 0.16 s. Measured
