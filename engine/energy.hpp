@@ -7,7 +7,8 @@
 //   W_mag = Σ_b [F_b · ½(v⁻ + v⁺) + τ_b · ½(ω⁻ + ω⁺)] h     F_b, τ_b the net magnetic force
 //                                                          and torque about the COM
 //   W_g   = Σ_b m_b g · ½(v⁻ + v⁺) h                       the work of gravity
-//   W_c   = ΔK − W_mag − W_g                               the contacts: the residual
+//   W_e   = the same sum for the eddy-current loss (eddy.cpp; 0 unless a scene sets σ)
+//   W_c   = ΔK − W_mag − W_g − W_e                         the contacts: the residual
 // ODE changes a body's momentum by the impulses h F of every force in the step
 // (m(v⁺ − v⁻) = h ΣF), so ΔK_lin = Σ h F · ½(v⁻ + v⁺) holds exactly, term by term: with the
 // trapezoid of the velocities each force's share of ΔK is exact, and the residual W_c is
@@ -21,7 +22,7 @@
 // against: ODE moves x by h v⁺ (semi-implicit Euler), so −ΔU_g = Σ m g·v⁺ h and
 //   D = −ΔU_g − W_g = Σ ½ m h g·(v⁺ − v⁻)          (= ½ m h² |g|² per free-falling body)
 // is the integrator's energy drift under gravity, kept apart (`gravity_drift`) so that
-//   ΔK + ΔU_g = W_mag + W_c − D     exactly.
+//   ΔK + ΔU_g = W_mag + W_e + W_c − D     exactly.
 // With it, K + U_g + Σ D stays constant in free fall; K + U_g alone loses ½ m h² |g|² per
 // step (4 g ball, 1 ms: 2·10⁻⁷ J per step).
 //
@@ -50,7 +51,10 @@ struct EnergyFlow {
   double gravitational_change = 0.0;  ///< ΔU_g, U_g = −Σ m g·x (J)
   double magnetic_work = 0.0;         ///< W_mag: magnetic forces and torques (J)
   double gravity_work = 0.0;          ///< W_g = Σ m g·½(v⁻ + v⁺) h (J)
-  double contact_work = 0.0;          ///< W_c = ΔK − W_mag − W_g: contacts, the residual (J)
+  /// W_e: the eddy-current loss's forces and torques (SimOptions::eddy_conductivity; ≤ 0 for
+  /// a body in a still field) (J)
+  double eddy_work = 0.0;
+  double contact_work = 0.0;          ///< W_c = ΔK − W_mag − W_g − W_e: contacts, the residual (J)
   double gravity_drift = 0.0;         ///< D = −ΔU_g − W_g: semi-implicit Euler's drift (J)
   /// Σ over bodies and ODE steps of max(0, W_c,b): what the contacts gave the bodies they
   /// sped up (J, ≥ 0). Includes transfers (a ball hitting a resting one), so it bounds the
@@ -91,10 +95,12 @@ void begin_audit_step(const EnergyAudit& a, EnergyAudit* next);
 /// Adds one ODE step of length h from `before` to `after` to acc->total and acc->last and
 /// sets acc->kinetic and acc->gravitational to those of `after`. body_force and body_torque
 /// (nbody) are the net magnetic force (N) and torque about the COM (N·m) that were applied
-/// during the step; a body asleep before and after the step got none. Call it once per ODE
+/// during the step; a body asleep before and after the step got none. eddy_force and
+/// eddy_torque (nbody, or empty = none) the same for the eddy-current loss. Call it once per ODE
 /// step: today once per rigid step with h = Δt_r; with ODE sub-steps, once per sub-step.
 void audit_substep(const Model& model, const State& before, const State& after,
                    const std::vector<Vec3>& body_force, const std::vector<Vec3>& body_torque,
+                   const std::vector<Vec3>& eddy_force, const std::vector<Vec3>& eddy_torque,
                    double h, EnergyAudit* acc);
 
 /// Interaction energy of the moments in `set` given H_j, the field at each moment (H0

@@ -85,6 +85,7 @@ void check_options(const SimOptions& o, const Vec3& H0) {
                                 " cores), got " + std::to_string(o.threads));
   check_non_negative("options.rolling_friction", o.rolling_friction, "m");
   check_non_negative("options.rolling_friction_bodies", o.rolling_friction_bodies, "m");
+  check_non_negative("options.eddy_conductivity", o.eddy_conductivity, "S/m");
   if (o.max_substeps < 1 || o.max_substeps > 64)
     fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
   if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))

@@ -175,6 +175,11 @@ struct SimOptions {
   /// sakura_tree such balls swing at up to 1.7 m/s and 800 rad/s a second after landing.
   /// Three more rows on every contact between bodies (QuickStep's cost grows with them).
   double rolling_friction_bodies = 0.0;
+  /// Electrical conductivity σ (S/m) of the induced bodies: the eddy-current loss of a body
+  /// whose flux density changes in its own frame (moving through a field's gradient,
+  /// spinning against the field), P = σ a² V |Ḃ|² / 10 per moment (engine/eddy.cpp). No field,
+  /// no loss. Iron 1.0e7; 0 = none.
+  double eddy_conductivity = 0.0;
   double restitution = 0.0;        ///< bounce in [0, 1]
   double erp = 0.2;                ///< ODE error reduction parameter
   double cfm = 1e-9;               ///< ODE constraint force mixing

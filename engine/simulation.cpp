@@ -95,6 +95,7 @@ void Simulation::rollback() {
     ode_->discard_contacts();
   }
   ode_->write_state(state_);
+  ws_.eddy_h = 0.0;  // the eddy loss's last flux densities belong to the failed step
   load_magnetization(state_, &moments_);
   place_moments(*model_, state_, &moments_);
 }

@@ -49,4 +49,18 @@ void balance_magnetic_torque(const Model& model, const mag::MomentSet& set, Work
 void torque_balance_forces(const std::vector<Vec3>& x, const std::vector<double>& w, const Vec3& L,
                            std::vector<Vec3>* dF);
 
+// (3b) eddy.cpp
+/// SimOptions::eddy_conductivity: the eddy-current loss of the induced moments' bodies,
+/// taken implicitly over the ODE step h starting at s, added to ODE as a force and torque per
+/// body (ws->eddy_force, ws->eddy_torque; zero when σ = 0 or on the first step). Needs the
+/// fields and Jacobians of the force stage (ws->mag.H, ws->mag.J).
+void apply_eddy_losses(const Model& model, const mag::MomentSet& set, const State& s, double h,
+                       Workspace* ws, OdeBridge* ode);
+/// c = σ a² V / 10 (a = the radius of a sphere of volume V): P = c |Ḃ|² (W).
+double eddy_coefficient(double conductivity, double volume);
+/// B = μ0 (H + ⅔ M), the flux density inside a uniformly magnetized sphere in the field H (T).
+Vec3 eddy_flux_density(const Vec3& H, const Vec3& M);
+/// ∂B/∂p = μ0 (1 + ⅔ ∂M/∂H) ∂H/∂p for M = f(H) of the curve (T/m).
+Mat3 eddy_flux_gradient(mag::Curve curve, const Vec3& H, double Ms, const Mat3& J);
+
 }  // namespace magsim::engine

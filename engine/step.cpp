@@ -5,6 +5,7 @@
 //   per sub-step of Δt_r/n:
 //   (2) magnetization dynamics until converged or capped      magnetize.cpp
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
+//   (3b) eddy-current loss (scenes that set a conductivity)   eddy.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
 //   then read back, check for non-finite values, commit       safety.cpp
 //   (and the energy audit of the step, committed with it)     energy.cpp
@@ -75,7 +76,7 @@ void Simulation::step() {
         place_moments(m, ws_.next, &moments_);
         // energy audit of the sub-step just taken (its forces are still in ws_)
         audit_substep(m, k == 1 ? state_ : ws_.sub_prev, ws_.next, ws_.body_force,
-                      ws_.body_torque, h, &ws_.audit);
+                      ws_.body_torque, ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
         ws_.sub_prev = ws_.next;
       }
       const State& now = k == 0 ? state_ : ws_.next;
@@ -93,6 +94,8 @@ void Simulation::step() {
         compute_magnetic_forces(m, moments_, &ws_);
         check_forces(m, ws_, n);
         apply_magnetic_forces(m, moments_, &ws_, ode_.get());
+        // (3b) the eddy-current loss of conducting bodies (off unless the scene sets σ)
+        apply_eddy_losses(m, moments_, now, h, &ws_, ode_.get());
       }
 
       // (4) collide and step the rigid bodies over h
@@ -131,8 +134,8 @@ void Simulation::step() {
       if (m.dynamic_moments)
         for (int b : m.dynamic_bodies) next.mag_accel[b] = ws_.body_force[b].norm() / m.body_mass[b];
       // energy audit: the work of the last ODE step (O(bodies)); U_mag from the forces' field
-      audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque, h,
-                    &ws_.audit);
+      audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque,
+                    ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
       // the potential of the force where it has one (zeeman-total: E_sys, forces.hpp)
       ws_.audit.magnetic_energy =
           m.options.force_model == ForceChoice::ZeemanTotal && ws_.mag.H.size() == moments_.size()

@@ -25,6 +25,13 @@ struct Workspace {
   std::vector<Vec3> balance_force;
   std::vector<Vec3> balance_x;
   std::vector<double> balance_w;
+  /// SimOptions::eddy_conductivity (eddy.cpp): each induced moment's flux density in its body's
+  /// frame at the last ODE step (T), that step's length (s; 0 = none yet), and the loss's
+  /// force and torque per body this ODE step (N, N·m)
+  std::vector<Vec3> eddy_B;
+  double eddy_h = 0.0;
+  std::vector<Vec3> eddy_force;
+  std::vector<Vec3> eddy_torque;
   State sub_prev;                 ///< the state after the last sub-step (energy audit)
   State next;                     ///< the state being computed; swapped in when it checks out
   EnergyAudit audit;              ///< the energy audit being computed, committed with next

@@ -100,6 +100,7 @@ json to_json(const SimOptions& o) {
               {"substep_load", o.substep_load},
               {"rolling_friction", o.rolling_friction},
               {"rolling_friction_bodies", o.rolling_friction_bodies},
+              {"eddy_conductivity", o.eddy_conductivity},
               {"max_body_speed", o.max_body_speed},
               {"field_solver", mag::field_solver_name(f.solver)},
               {"bh_theta", f.bh_theta},
@@ -152,7 +153,8 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
                    "threads", "reaction_symmetric_forces", "balance_magnetic_torque", "field_solver",
                    "bh_theta", "bh_threshold", "magnetics", "force_model", "max_substeps", "substep_reach",
-                   "substep_load", "rolling_friction", "rolling_friction_bodies", "quickstep_w",
+                   "substep_load", "rolling_friction", "rolling_friction_bodies", "eddy_conductivity",
+                   "quickstep_w",
                    "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order", "bh_near_float",
                    "bh_far_float"});
   if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
@@ -186,6 +188,8 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.non_negative(v, p); });
   if_present(j, "rolling_friction_bodies", path,
              [&](const json& v, const std::string& p) { o->rolling_friction_bodies = r.non_negative(v, p); });
+  if_present(j, "eddy_conductivity", path,
+             [&](const json& v, const std::string& p) { o->eddy_conductivity = r.non_negative(v, p); });
   if_present(j, "quickstep_w", path, [&](const json& v, const std::string& p) {
     o->quickstep_w = r.number(v, p);
     if (!(o->quickstep_w > 0 && o->quickstep_w < 2)) r.fail(p, "must be in (0, 2) (got " + JsonReader::fmt(o->quickstep_w) + ")");

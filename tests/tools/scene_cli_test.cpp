@@ -49,7 +49,8 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
   const auto& e = j["energy"];
   CHECK(e["substeps"] == 3);
   const double balance = e["kinetic_change"].get<double>() + e["gravitational_change"].get<double>() -
-                         e["magnetic_work"].get<double>() - e["contact_work"].get<double>() +
+                         e["magnetic_work"].get<double>() - e["eddy_work"].get<double>() -
+                         e["contact_work"].get<double>() +
                          e["gravity_drift"].get<double>();
   CHECK(std::abs(balance) <= 1e-12 + 1e-9 * std::abs(e["magnetic_work"].get<double>()));
   CHECK(e["kinetic"].get<double>() == Approx(j["final"]["kinetic_energy"].get<double>()).epsilon(1e-12));
@@ -118,7 +119,7 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   const std::string out = tmp_dir("replay");
   const Result r = run_scene("balls_up --count 27 --steps 50 --no-render --space hash --dt-m 8e-8 --tol 3e-5 "
                              "--quickstep-iterations 40 --quickstep-w 1.2 --rolling-friction 1e-4 --rolling-friction-bodies 2e-4 "
-                             "--max-substeps 2 "
+                             "--eddy-conductivity 5e6 --max-substeps 2 "
                              "--substep-load off "
                              "--method anderson --threads 1 --out " + out);
   INFO(r.out);
@@ -129,6 +130,8 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   CHECK(summary["options"]["method"] == "anderson");
   CHECK(summary["options"]["substep_load"] == false);
   CHECK(summary["options"]["rolling_friction_bodies"] == 2e-4);
+  CHECK(summary["options"]["eddy_conductivity"] == 5e6);
+  CHECK(summary["energy"]["eddy_work"].get<double>() < 0);  // the balls move in the magnet's field
   // the registry scene's bodies with the summary's options, read as a scene file
   magsim::scenes::SceneParams p;
   p.count = 27;

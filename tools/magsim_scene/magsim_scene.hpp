@@ -65,6 +65,7 @@ struct Args {
   std::string balance_magnetic_torque;
   double rolling_friction = 0.0;
   double rolling_friction_bodies = 0.0;
+  double eddy_conductivity = 0.0;
   double quickstep_w = 0.0;
   double dt = 0.0;
   std::string bounded_pairs;

@@ -93,6 +93,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     s.options.balance_magnetic_torque = on_off("--balance-magnetic-torque", a.balance_magnetic_torque);
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
   if (app.count("--rolling-friction-bodies")) s.options.rolling_friction_bodies = a.rolling_friction_bodies;
+  if (app.count("--eddy-conductivity")) s.options.eddy_conductivity = a.eddy_conductivity;
   if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
   if (app.count("--dt")) s.options.dt = a.dt;
   if (app.count("--bounded-pairs"))
@@ -200,6 +201,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--rolling-friction-bodies", a.rolling_friction_bodies,
                  "the same between two dynamic bodies (a ball rolling on a ball), rho (m) (0 = none; default: the scene's)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--eddy-conductivity", a.eddy_conductivity,
+                 "electrical conductivity sigma (S/m) of the induced bodies: eddy-current loss where their flux "
+                 "density changes in their own frame (iron 1e7; 0 = none; default: the scene's)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
       ->check(CLI::Range(1e-6, 1.999999));

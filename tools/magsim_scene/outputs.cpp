@@ -55,6 +55,7 @@ json energy_flow_json(const engine::EnergyFlow& f) {
               {"gravitational_change", f.gravitational_change},
               {"magnetic_work", f.magnetic_work},
               {"gravity_work", f.gravity_work},
+              {"eddy_work", f.eddy_work},
               {"contact_work", f.contact_work},
               {"gravity_drift", f.gravity_drift},
               {"contact_work_in", f.contact_work_in}};
@@ -65,7 +66,7 @@ json energy_flow_json(const engine::EnergyFlow& f) {
 // summary.json "energy": the audit at the end of the run (J); "last_step" = the increments
 // of the final step; "escaped_bodies" = the escaped bodies' kinetic energy now and the
 // magnetic and contact work done on them since t = 0 (net, and "_in": the positive steps).
-// ΔK + ΔU_g = magnetic_work + contact_work − gravity_drift.
+// ΔK + ΔU_g = magnetic_work + eddy_work + contact_work − gravity_drift.
 json energy_json(const engine::Simulation& sim) {
   const engine::EnergyAudit& e = sim.energy();
   json j = energy_flow_json(e.total);
