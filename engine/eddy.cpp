@@ -51,7 +51,7 @@ Mat3 cross_matrix(const Vec3& u) {
 }  // namespace
 
 double eddy_coefficient(double conductivity, double volume) {
-  const double a = std::cbrt(3.0 * volume / (4.0 * M_PI));
+  const double a = std::cbrt(3.0 * volume / (4.0 * mag::kPi));
   return conductivity * a * a * volume / 10.0;
 }
 
