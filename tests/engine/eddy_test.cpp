@@ -43,12 +43,7 @@ namespace {
 // One iron ball in a uniform field, no gravity, no ground: nothing but the eddy loss acts on
 // its spin.
 engine::SceneDesc spinning_ball(const Vec3& w0, double sigma) {
-  engine::SceneDesc s;
-  s.name = "spinning_ball";
-  s.options.method = mag::Method::OursRealigned;
-  s.options.threads = 1;
-  s.options.gravity = Vec3::Zero();
-  s.options.ground = false;
+  engine::SceneDesc s = free_space("spinning_ball");
   s.options.eddy_conductivity = sigma;
   s.H0 = Vec3(0, 0, 1e5);  // A/m: M = Ms tanh(3 |H| / Ms) = 0.19 Ms
   BodyDesc ball = iron_ball("ball", Vec3::Zero());
@@ -105,12 +100,7 @@ TEST_CASE("eddy: a ball flying past a magnet only loses energy to the loss", "[e
   // a step can give back a little (second order). The ball leaves slower than without the
   // loss by what the loss took.
   auto run = [](double sigma, double* given_back) {
-    engine::SceneDesc s;
-    s.name = "flyby";
-    s.options.method = mag::Method::OursRealigned;
-    s.options.threads = 1;
-    s.options.gravity = Vec3::Zero();
-    s.options.ground = false;
+    engine::SceneDesc s = free_space("flyby");
     s.options.eddy_conductivity = sigma;
     s.bodies.push_back(cube_magnet(Vec3::Zero(), Vec3(0, 0, 1.0)));
     BodyDesc ball = iron_ball("ball", Vec3(0.03, -0.06, 0));

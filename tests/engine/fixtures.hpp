@@ -34,6 +34,18 @@ inline BodyDesc iron_ball(const std::string& name, const Vec3& p, double r = kR)
   return b;
 }
 
+/// An empty world with nothing outside acting: no gravity, no ground; ours-realigned on one
+/// magnetics thread.
+inline SceneDesc free_space(const std::string& name) {
+  SceneDesc s;
+  s.name = name;
+  s.options.method = mag::Method::OursRealigned;
+  s.options.threads = 1;
+  s.options.gravity = Vec3::Zero();
+  s.options.ground = false;
+  return s;
+}
+
 /// A static 1 cm cube magnet with a permanent moment m (A·m², body frame).
 inline BodyDesc cube_magnet(const Vec3& p, const Vec3& m) {
   BodyDesc b;

@@ -91,12 +91,7 @@ namespace {
 // A free NdFeB sphere magnet (tilted moment) with iron balls stuck on it and on each other,
 // no gravity, no ground: nothing outside acts, so the total angular momentum must stay 0.
 engine::SceneDesc free_magnet_with_iron(bool balance) {
-  engine::SceneDesc s;
-  s.name = "free_magnet";
-  s.options.method = mag::Method::OursRealigned;
-  s.options.threads = 1;
-  s.options.gravity = Vec3::Zero();
-  s.options.ground = false;
+  engine::SceneDesc s = free_space("free_magnet");
   s.options.reaction_symmetric_forces = true;
   s.options.balance_magnetic_torque = balance;
   engine::BodyDesc magnet;
