@@ -346,14 +346,16 @@ ENERGY_SERIES = (("energy_kinetic", "kinetic K", "tab:blue"),
                  ("energy_gravitational", "gravitational U_g − U_g(0)", "tab:brown"),
                  ("energy_magnetic_work", "magnetic work W_mag", "tab:red"),
                  ("energy_contact_work", "contact work W_c", "tab:green"),
+                 ("energy_eddy_work", "eddy-current loss W_e", "tab:orange"),
                  ("energy_magnetic", "magnetic energy U_mag − U_mag(first)", "tab:purple"))
 
 
 def energy(summary_path, png_path):
     """The energy audit of one run (magsim-scene's summary.json, engine/energy.hpp): K, U_g,
-    the cumulative magnetic and contact work and U_mag over time (offsets removed so that
-    every curve starts at 0 except K), and below, the power of the magnetic forces and of
-    the contacts between frames (J/s): where the energy of scattered bodies comes from."""
+    the cumulative magnetic and contact work (and the eddy-current loss's, where a run has one)
+    and U_mag over time (offsets removed so that every curve starts at 0 except K), and below,
+    the power of the magnetic forces and of the contacts between frames (J/s): where the
+    energy of scattered bodies comes from."""
     with open(summary_path) as f:
         s = json.load(f)
     ser = s.get("series", {})
@@ -364,6 +366,8 @@ def energy(summary_path, png_path):
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True,
                                   gridspec_kw={"height_ratios": [3, 2]})
     for key, label, color in ENERGY_SERIES:
+        if key == "energy_eddy_work" and not any(ser.get(key, [])):
+            continue  # no eddy loss in this run (or a summary from before it existed)
         tt, y = t, ser[key]
         if key == "energy_magnetic":
             # U_mag is known from the first step on (the frame at t = 0 holds 0)
@@ -381,7 +385,10 @@ def energy(summary_path, png_path):
                  f"W_c {e.get('contact_work', float('nan')):.3g} J, K {e.get('kinetic', float('nan')):.3g} J)",
                  fontsize=10)
     for key, label, color in (("energy_magnetic_work", "magnetic", "tab:red"),
-                              ("energy_contact_work", "contacts", "tab:green")):
+                              ("energy_contact_work", "contacts", "tab:green"),
+                              ("energy_eddy_work", "eddy-current loss", "tab:orange")):
+        if key == "energy_eddy_work" and not any(ser.get(key, [])):
+            continue
         y = ser[key]
         p = [(y[i] - y[i - 1]) / (t[i] - t[i - 1]) for i in range(1, len(t)) if t[i] > t[i - 1]]
         tm = [0.5 * (t[i] + t[i - 1]) for i in range(1, len(t)) if t[i] > t[i - 1]]

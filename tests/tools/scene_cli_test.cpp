@@ -61,7 +61,7 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
   CHECK(e["escaped_bodies"]["count"] == j["final"]["escaped"]);
   CHECK(e["contact_work_in"].get<double>() >= 0);
   for (const char* k : {"energy_kinetic", "energy_gravitational", "energy_magnetic_work",
-                        "energy_contact_work", "energy_magnetic"})
+                        "energy_contact_work", "energy_eddy_work", "energy_magnetic"})
     CHECK(j["series"][k].size() == j["series"]["time"].size());
 }
 

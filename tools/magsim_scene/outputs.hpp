@@ -124,6 +124,7 @@ class Recorder {
     series_["energy_magnetic"].push_back(e.magnetic_energy);
     series_["energy_magnetic_work"].push_back(e.total.magnetic_work);
     series_["energy_contact_work"].push_back(e.total.contact_work);
+    series_["energy_eddy_work"].push_back(e.total.eddy_work);
     series_["energy_gravity_work"].push_back(e.total.gravity_work);
     series_["energy_gravity_drift"].push_back(e.total.gravity_drift);
     series_["energy_step_magnetic_work"].push_back(e.last.magnetic_work);
