@@ -64,9 +64,13 @@ Mat3 eddy_flux_gradient(mag::Curve curve, const Vec3& H, double Ms, const Mat3& 
 void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s, double h,
                        Workspace* ws, OdeBridge* ode) {
   const double sigma = m.options.eddy_conductivity;
+  if (!(sigma > 0.0)) {  // off: empty vectors tell the energy audit there is no such force
+    ws->eddy_force.clear();
+    ws->eddy_torque.clear();
+    return;
+  }
   ws->eddy_force.assign(m.nbody, Vec3::Zero());
   ws->eddy_torque.assign(m.nbody, Vec3::Zero());
-  if (!(sigma > 0.0)) return;
   const mag::Curve curve = mag::curve_of(m.options.method);
   const std::vector<Vec3>& H = ws->mag.H;
   const std::vector<Mat3>& J = ws->mag.J;

@@ -51,8 +51,8 @@ struct EnergyFlow {
   double gravitational_change = 0.0;  ///< ΔU_g, U_g = −Σ m g·x (J)
   double magnetic_work = 0.0;         ///< W_mag: magnetic forces and torques (J)
   double gravity_work = 0.0;          ///< W_g = Σ m g·½(v⁻ + v⁺) h (J)
-  /// W_e: the eddy-current loss's forces and torques (SimOptions::eddy_conductivity; ≤ 0 for
-  /// a body in a still field) (J)
+  /// W_e: the eddy-current loss's forces and torques (SimOptions::eddy_conductivity) (J); ≤ 0
+  /// for a body in a still field up to second order (Ḃ is measured over the step before)
   double eddy_work = 0.0;
   double contact_work = 0.0;          ///< W_c = ΔK − W_mag − W_g − W_e: contacts, the residual (J)
   double gravity_drift = 0.0;         ///< D = −ΔU_g − W_g: semi-implicit Euler's drift (J)

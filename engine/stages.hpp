@@ -52,7 +52,7 @@ void torque_balance_forces(const std::vector<Vec3>& x, const std::vector<double>
 // (3b) eddy.cpp
 /// SimOptions::eddy_conductivity: the eddy-current loss of the induced moments' bodies,
 /// taken implicitly over the ODE step h starting at s, added to ODE as a force and torque per
-/// body (ws->eddy_force, ws->eddy_torque; zero when σ = 0 or on the first step). Needs the
+/// body (ws->eddy_force, ws->eddy_torque: empty when σ = 0, zero on the first step). Needs the
 /// fields and Jacobians of the force stage (ws->mag.H, ws->mag.J).
 void apply_eddy_losses(const Model& model, const mag::MomentSet& set, const State& s, double h,
                        Workspace* ws, OdeBridge* ode);

@@ -27,7 +27,7 @@ struct Workspace {
   std::vector<double> balance_w;
   /// SimOptions::eddy_conductivity (eddy.cpp): each induced moment's flux density in its body's
   /// frame at the last ODE step (T), that step's length (s; 0 = none yet), and the loss's
-  /// force and torque per body this ODE step (N, N·m)
+  /// force and torque per body this ODE step (N, N·m; empty when the loss is off)
   std::vector<Vec3> eddy_B;
   double eddy_h = 0.0;
   std::vector<Vec3> eddy_force;
