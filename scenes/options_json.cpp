@@ -154,9 +154,8 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "threads", "reaction_symmetric_forces", "balance_magnetic_torque", "field_solver",
                    "bh_theta", "bh_threshold", "magnetics", "force_model", "max_substeps", "substep_reach",
                    "substep_load", "rolling_friction", "rolling_friction_bodies", "eddy_conductivity",
-                   "quickstep_w",
-                   "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order", "bh_near_float",
-                   "bh_far_float"});
+                   "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
+                   "bh_near_float", "bh_far_float"});
   if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   if_present(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
