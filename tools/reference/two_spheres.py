@@ -434,7 +434,9 @@ def cmd_force(args):
 
 
 def chart_gaps():
-    return np.logspace(math.log10(0.003), math.log10(3.0), 31)
+    """g/a from 0.003 to 3: 31 log-spaced gaps and the decades 0.01, 0.1, 1."""
+    grid = np.logspace(math.log10(0.003), math.log10(3.0), 31)
+    return np.unique(np.concatenate((grid, [0.01, 0.1, 1.0])))
 
 
 def cmd_chart(args):
@@ -459,7 +461,7 @@ def cmd_chart(args):
     csv_path = os.path.join(args.out, "two_spheres_ratio.csv")
     with open(csv_path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["field", "mu", "gap_over_a", "F_exact", "F_dipole", "ratio_exact_over_dipole", "L"])
+        w.writerow(["field", "mu", "gap_over_a", "F_exact", "F_dipole", "ratio_exact_over_dipole", "L_final"])
         for r in rows:
             w.writerow([r[0], r[1], f"{r[2]:.6g}", f"{r[3]:.10g}", f"{r[4]:.10g}", f"{r[5]:.8g}", r[6]])
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
@@ -514,9 +516,10 @@ def main(argv=None):
                     help="truncation order (default: doubled from --L0 until converged)")
     conv_opts(sf)
     sc = sub.add_parser("chart", help="ratio exact / dipole model against gap (PNG + CSV)",
-                        description="Force ratio exact / dipole model for g/a from 0.003 to 3 (31 gaps, "
-                                    "log), axial and transverse, mu = inf, 1000, 10: "
-                                    "DIR/two_spheres_ratio.png and .csv.")
+                        description="Force ratio exact / dipole model for g/a from 0.003 to 3 (31 log-spaced "
+                                    "gaps and 0.01, 0.1, 1), axial and transverse, mu = inf, 1000, 10: "
+                                    "DIR/two_spheres_ratio.png and .csv (L_final: the last truncation "
+                                    "order of the doubling, whose force changed by less than --rtol).")
     sc.add_argument("--out", required=True, help="output directory")
     sc.add_argument("--rtol", type=float, default=1e-7, help="convergence in L (default 1e-7)")
     args = p.parse_args(argv)
