@@ -136,7 +136,8 @@ def translation_coefficient(n, k, m, sigma, dist):
 
 
 def system(mu, gap, field, L):
-    """The halved linear system A x = rhs for x_n = B^1_n, n = 1..L (see the module doc)."""
+    """The halved linear system A x = rhs for x_n = B^1_n, n = 1..L (see the module doc), and
+    T, the matrix that maps x to the regular part: E_k = -delta_{k1} + (T x)_k."""
     m = order_of(field)
     dist = 2.0 + gap
     n = np.arange(1, L + 1)
