@@ -1,6 +1,7 @@
 // engine/apply_forces.cpp — stage 3 of a step (Algorithm 1, "compute F using eq. 4"): one
 // field + Jacobian evaluation at the converged magnetizations gives the force on every
-// moment (the method's force model: Zeeman eq. 4 for ours, classic eqs. 13–14 for Kim 2018)
+// moment (the resolved force model, resolved_force_model: classic eqs. 13–14 by default and for
+// Kim 2018, Zeeman eq. 4 for the paper's θ dynamics)
 // and the torque on permanent moments (τ = μ0 m × H); they act on the dynamic bodies.
 #include "engine/stages.hpp"
 
@@ -12,13 +13,7 @@
 namespace magsim::engine {
 
 void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
-  const mag::Method method = m.options.method;
-  const ForceChoice fc = m.options.force_model;
-  const mag::ForceModel model = fc == ForceChoice::Zeeman        ? mag::ForceModel::Zeeman
-                                : fc == ForceChoice::Classic     ? mag::ForceModel::Classic
-                                : fc == ForceChoice::ZeemanTotal ? mag::ForceModel::ZeemanTotal
-                                                                 : mag::force_model_of(method);
-  mag::compute_forces(set, model, mag::curve_of(method),
+  mag::compute_forces(set, resolved_force_model(m.options), mag::curve_of(m.options.method),
                       m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
                       m.options.reaction_symmetric_forces);
 }

@@ -33,6 +33,8 @@ void add(const EnergyFlow& d, EnergyFlow* to) {
   to->contact_work += d.contact_work;
   to->gravity_drift += d.gravity_drift;
   to->contact_work_in += d.contact_work_in;
+  to->energy_created += d.energy_created;
+  to->energy_dissipated += d.energy_dissipated;
 }
 
 }  // namespace
@@ -100,18 +102,6 @@ void audit_substep(const Model& m, const State& before, const State& after,
   acc->kinetic = k_after;
   acc->gravitational = u_after;
   ++acc->substeps;
-}
-
-double magnetic_energy(const mag::MomentSet& set, const std::vector<Vec3>& H) {
-  if (H.size() != set.size()) return 0.0;
-  // U = −½ μ0 Σ m_j·(H_j − H0) − μ0 Σ m_j·H0: pairs once each, the uniform field in full
-  double pairs = 0.0, uniform = 0.0;
-  for (std::size_t j = 0; j < set.size(); ++j) {
-    const Vec3 mj = set.moment(j);
-    pairs += mj.dot(H[j] - set.H0);
-    uniform += mj.dot(set.H0);
-  }
-  return -0.5 * mag::kMu0 * pairs - mag::kMu0 * uniform;
 }
 
 }  // namespace magsim::engine

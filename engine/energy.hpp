@@ -26,11 +26,17 @@
 // With it, K + U_g + Σ D stays constant in free fall; K + U_g alone loses ½ m h² |g|² per
 // step (4 g ball, 1 ms: 2·10⁻⁷ J per step).
 //
-// Magnetic energy: eq. 4's Zeeman force is the gradient of each moment's own energy with the
-// sources held fixed, not of any total energy (it breaks action = reaction, see forces.hpp),
-// and the classic force of Kim 2018 is not conservative for moments that change with the
-// field either; so W_mag — the work the engine actually did — is the audit's main quantity,
-// and `magnetic_energy` (below) is a reference only.
+// Magnetic energy: U*, the co-energy of the moments (magnetics/coenergy.hpp). The classic
+// force with converged magnetizations is exactly −∇U*, so for it (and for zeeman-total, whose
+// potential E_sys replaces U*) the total E = K + U_g + U* can only fall, through the contacts,
+// the eddy loss and the integrator; a rise is energy the step created. eq. 4's Zeeman force
+// is not the gradient of any energy (it breaks action = reaction, see forces.hpp): there U* is
+// still the moments' co-energy, and E measures what eq. 4 adds beyond it.
+//
+// Per rigid step (the frame, all of its sub-steps), E_start = K + U_g + U* at its start and
+// E_end at its end (U* from the field the next step's forces use: the end state's converged
+// magnetization), ΔE = E_end − E_start:
+//   created    = Σ_steps max(0, ΔE)        dissipated = Σ_steps max(0, −ΔE).
 //
 // Cost: O(bodies) per step (two kinetic energies and a few dot products per body), no
 // allocation; the magnetic energy reuses the field the force stage evaluated (O(moments),
@@ -60,6 +66,10 @@ struct EnergyFlow {
   /// sped up (J, ≥ 0). Includes transfers (a ball hitting a resting one), so it bounds the
   /// contacts' injection from above; contact_work_in − contact_work = what they took.
   double contact_work_in = 0.0;
+  /// Σ over rigid steps of max(0, ΔE), ΔE the step's change of E = K + U_g + U* (J, ≥ 0)
+  double energy_created = 0.0;
+  /// Σ over rigid steps of max(0, −ΔE) (J, ≥ 0)
+  double energy_dissipated = 0.0;
 };
 
 /// The audit of a run: state functions now, and the work done since t = 0.
@@ -68,12 +78,16 @@ struct EnergyAudit {
   double gravitational = 0.0;          ///< U_g = −Σ m g·x over dynamic bodies (J)
   double initial_kinetic = 0.0;        ///< K at the start of the audit (J)
   double initial_gravitational = 0.0;  ///< U_g at the start of the audit (J)
-  /// Interaction energy of the moments (J) from the last field evaluation (the force stage
-  /// of the last step: poses before its rigid step, converged magnetizations), see
-  /// magnetic_energy(); 0 before the first step or when no field has been evaluated. With
-  /// the zeeman-total force model it is that force's potential E_sys (mag::
-  /// zeeman_total_energy), so W_mag ≈ −ΔU_mag up to the rigid step's integration error.
+  /// U* (J), the co-energy of the moments at the state (magnetics/coenergy.hpp), from the
+  /// field of its converged magnetization; 0 before the first step. With the zeeman-total
+  /// force model it is that force's potential E_sys (mag::zeeman_total_energy).
   double magnetic_energy = 0.0;
+  /// E = K + U_g + U* at the start of the audit's first step (J)
+  double initial_total = 0.0;
+  /// retakes of rigid steps by the energy guard (SimOptions::energy_guard), and the steps it
+  /// accepted at its sub-step cap with E still rising by more than its tolerance
+  long guard_retakes = 0;
+  long guard_unresolved = 0;
   EnergyFlow total;  ///< sums since the start of the audit
   EnergyFlow last;   ///< the last rigid step (the sum over its ODE sub-steps)
   long substeps = 0;  ///< ODE steps audited
@@ -103,16 +117,9 @@ void audit_substep(const Model& model, const State& before, const State& after,
                    const std::vector<Vec3>& eddy_force, const std::vector<Vec3>& eddy_torque,
                    double h, EnergyAudit* acc);
 
-/// Interaction energy of the moments in `set` given H_j, the field at each moment (H0
-/// included, as compute_fields returns it):
-///   U = −½ μ0 Σ_j m_j·(H_j − H0) − μ0 Σ_j m_j·H0     (J)
-/// the energy of fixed dipoles: every pair once, plus each moment in the uniform field.
-/// Exact for permanent–permanent pairs. For an induced moment it treats m_j as rigid; for
-/// linear (unsaturated) material the stored energy is half of the induced part (the other
-/// half goes into magnetizing the iron), so U overstates the binding of unsaturated iron by
-/// up to 2× — we keep the fixed-dipole form: it needs no curve and is right for saturated
-/// iron. Pairs within one body are included (constant for rigid permanent moments). Returns
-/// 0 when H does not match the set (no field evaluated yet).
-double magnetic_energy(const mag::MomentSet& set, const std::vector<Vec3>& H);
+/// E = K + U_g + U* of an audit's state (J).
+inline double total_energy(const EnergyAudit& a) {
+  return a.kinetic + a.gravitational + a.magnetic_energy;
+}
 
 }  // namespace magsim::engine

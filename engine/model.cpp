@@ -90,6 +90,11 @@ void check_options(const SimOptions& o, const Vec3& H0) {
     fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
   if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))
     fail("options.substep_reach", "must be > 0 and finite (got " + fmt(o.substep_reach) + ")");
+  check_non_negative("options.energy_guard_tolerance", o.energy_guard_tolerance);
+  check_non_negative("options.energy_guard_floor", o.energy_guard_floor, "J");
+  if (o.energy_guard_max_substeps < 1 || o.energy_guard_max_substeps > 64)
+    fail("options.energy_guard_max_substeps",
+         "must be in [1, 64] (got " + std::to_string(o.energy_guard_max_substeps) + ")");
   if (o.balance_magnetic_torque && !o.reaction_symmetric_forces)
     fail("options.balance_magnetic_torque",
          "needs reaction_symmetric_forces (it removes the torque those forces leave)");

@@ -85,7 +85,8 @@ inline bool parse_space(const std::string& name, SpaceKind* out) {
 
 /// The force on induced moments, chosen apart from the magnetization method.
 enum class ForceChoice {
-  Method,   ///< the method's own pairing: classic for Kim 2018, Zeeman (eq. 4) otherwise
+  Method,   ///< the method's own pairing (mag::force_model_of): classic for anderson, exact and
+            ///< kim2018, Zeeman (eq. 4) for ours, ours-realigned and damping-llg
   Zeeman,   ///< eq. 4: F = μ0 V J [A (2M + H) + M]; 2(χ+1) ≈ 8× classic in the linear range
   Classic,  ///< eqs. 13–14: F = μ0 J m, m held constant
   /// eq. 4 as the gradient of the system's Zeeman energy, every magnetization a variable
@@ -117,10 +118,11 @@ inline bool parse_force_choice(const std::string& name, ForceChoice* out) {
 
 /// Run options. Defaults are the engine's; each scene overrides what it needs.
 struct SimOptions {
-  /// The paper's θ dynamics with the sub-pair re-aligned (DESIGN §6): the paper's literal
-  /// update (Method::Ours) does not converge in weakly magnetized piles (balls_up: the cap
-  /// every step, balls ejected), so the engine's default is the re-aligned one.
-  mag::Method method = mag::Method::OursRealigned;
+  /// The magnetization solve. The default, Anderson-accelerated M = f(H(M)) with the classic
+  /// force, converges every rigid (sub-)step and makes the force −∇U* (magnetics/coenergy.hpp):
+  /// passive scenes lose energy and come to rest. `ours` is the paper as printed (θ dynamics
+  /// eqs. 8–11, eq. 4), whose force has no energy.
+  mag::Method method = mag::Method::Anderson;
   /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps when the
   /// residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::criterion, default Residual)
   /// or after 100 sweeps per rigid step: warm-started from the last step, a converging method
@@ -146,6 +148,18 @@ struct SimOptions {
   bool balance_magnetic_torque = false;
   /// The force on induced moments (method = the method's own pairing, the default).
   ForceChoice force_model = ForceChoice::Method;
+  /// Energy guard, for conservative forces (classic, zeeman-total; eq. 4 has no energy and is
+  /// never guarded): a rigid step whose E = K + U_g + U* rises by more than
+  ///   energy_guard_tolerance · (K_start + K_end + |U*_start|) + energy_guard_floor
+  /// is rolled back and retaken from its start in twice as many sub-steps, up to
+  /// energy_guard_max_substeps; a step still rising there is kept and counted
+  /// (EnergyAudit::guard_unresolved). K the kinetic energy at the step's ends, U* the
+  /// co-energy at its start: the energy in play. A resting pile's contacts make E jitter by
+  /// ~1e-5–1e-4 of it per step (tools/findings/energy.md); the default sits above that.
+  bool energy_guard = true;
+  double energy_guard_tolerance = 1e-3;  ///< relative to K_start + K_end + |U*_start|, ≥ 0
+  double energy_guard_floor = 1e-6;      ///< (J), ≥ 0
+  int energy_guard_max_substeps = 32;    ///< in [1, 64]
   double dt = 1e-3;                ///< rigid step Δt_r (s), the frame step
   /// Adaptive rigid sub-steps: each frame of Δt_r is split into n ODE steps of Δt_r/n, each
   /// with its own magnetization solve (warm-started from the previous sub-step) and forces,
@@ -210,6 +224,32 @@ struct SimOptions {
   /// hence 1000 rather than 100. 0 = off. (Kept last in the struct.)
   double max_body_speed = 1000.0;
 };
+
+/// The force on induced moments that `o` resolves to (ForceChoice::Method: the method's own
+/// pairing, mag::force_model_of).
+inline mag::ForceModel resolved_force_model(const SimOptions& o) {
+  switch (o.force_model) {
+    case ForceChoice::Zeeman: return mag::ForceModel::Zeeman;
+    case ForceChoice::Classic: return mag::ForceModel::Classic;
+    case ForceChoice::ZeemanTotal: return mag::ForceModel::ZeemanTotal;
+    case ForceChoice::Method: break;
+  }
+  return mag::force_model_of(o.method);
+}
+/// A resolved force in --force-model's spelling: "zeeman" (eq. 4), "classic", "zeeman-total".
+inline const char* force_model_name(mag::ForceModel f) {
+  switch (f) {
+    case mag::ForceModel::Zeeman: return "zeeman";
+    case mag::ForceModel::Classic: return "classic";
+    case mag::ForceModel::ZeemanTotal: return "zeeman-total";
+  }
+  return "?";
+}
+/// The resolved force is the gradient of an energy (classic: −∇U*; zeeman-total: −∇E_sys), so
+/// the energy guard can check it. eq. 4 (zeeman) is not.
+inline bool force_conservative(const SimOptions& o) {
+  return resolved_force_model(o) != mag::ForceModel::Zeeman;
+}
 
 struct SceneDesc {
   std::string name;

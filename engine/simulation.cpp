@@ -96,6 +96,7 @@ void Simulation::rollback() {
   }
   ode_->write_state(state_);
   ws_.eddy_h = 0.0;  // the eddy loss's last flux densities belong to the failed step
+  ws_.forces_ready = false;  // the next step evaluates them from state_'s magnetization
   load_magnetization(state_, &moments_);
   place_moments(*model_, state_, &moments_);
 }

@@ -88,6 +88,14 @@ class Simulation {
   void inject_velocity_for_testing(int body, const Vec3& v);
 
  private:
+  /// One try at the step from state_ in nsub rigid sub-steps, into ws_.next and ws_.audit
+  /// (E at both ends, ws_.coenergy_start and ws_.audit.magnetic_energy); nothing committed.
+  void attempt(int nsub, long n);
+  /// Stages 2 and 3 at the moments' current poses: the magnetization solve (unless the
+  /// magnetization is already the converged one) and the forces into ws_ (not applied).
+  void solve_magnetics(bool solve, long n);
+  /// U* (or zeeman-total's E_sys) from the field of the last force evaluation (J).
+  double coenergy() const;
   void rollback();
   void check_body_index(int i) const;
 

@@ -37,6 +37,9 @@ struct State {
   /// the next step's sub-steps (SimOptions::substep_load). Derived data as dvel: kept so that
   /// a restored state continues as the original; not part of the hash. Empty = zero.
   std::vector<double> mag_accel;
+  /// M is the converged magnetization at these poses (every state a step produced): the
+  /// next step's first forces need no solve. false at t = 0 (unmagnetized). Not hashed.
+  bool magnetized = false;
 };
 
 /// The state at t = 0: the scene's poses and velocities, unmagnetized induced moments.

@@ -7,8 +7,11 @@
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
 //   (3b) eddy-current loss (scenes that set a conductivity)   eddy.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
-//   then read back, check for non-finite values, commit       safety.cpp
-//   (and the energy audit of the step, committed with it)     energy.cpp
+//   then read back, check for non-finite values                safety.cpp
+//   (2)+(3) again at the end state: its converged magnetization, U*, and the forces the
+//   next step starts with (so a frame solves once per sub-step, as before)
+//   the energy guard: E = K + U_g + U* rose too much → retake in more sub-steps
+//   commit, with the energy audit of the step                  energy.cpp
 //
 // The step works on ws_.next and swaps it into state_ only when every check passes, so
 // state_ is always the last good state; on failure ODE and the moments are rewound to it.
@@ -16,9 +19,13 @@
 
 #include "engine/ode_bridge.hpp"
 #include "engine/stages.hpp"
+#include "magnetics/coenergy.hpp"
 #include "magnetics/forces.hpp"
 
 #include <omp.h>
+
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace magsim::engine {
@@ -41,116 +48,181 @@ class OmpThreadScope {
 
 }  // namespace
 
+double Simulation::coenergy() const {
+  const Model& m = *model_;
+  if (ws_.mag.H.size() != moments_.size()) return 0.0;
+  // the potential of the force where it has its own (zeeman-total: E_sys, forces.hpp)
+  if (resolved_force_model(m.options) == mag::ForceModel::ZeemanTotal)
+    return mag::zeeman_total_energy(moments_, mag::curve_of(m.options.method), ws_.mag.H,
+                                    ws_.mag.total.perm, ws_.mag.total.Hp);
+  return mag::magnetic_coenergy(moments_, mag::curve_of(m.options.method), ws_.mag.H);
+}
+
+void Simulation::solve_magnetics(bool solve, long n) {
+  const Model& m = *model_;
+  StepProfile& prof = profile_;
+  // (2) magnetization dynamics on the Δt_m clock, warm-started from the last (sub-)step
+  if (solve) {
+    ScopedTimer t(&prof.T_i);
+    magnetize(m, &moments_, &ws_, &prof);
+  }
+  check_magnetization(m, moments_, n);
+  // (3) forces (eqs. 13–14 or eq. 4) and torques on the moments
+  if (m.dynamic_moments) {
+    ScopedTimer t(&prof.T_f);
+    compute_magnetic_forces(m, moments_, &ws_);
+    check_forces(m, ws_, n);
+  }
+}
+
+void Simulation::attempt(int nsub, long n) {
+  const Model& m = *model_;
+  StepProfile& prof = profile_;
+  begin_audit_step(energy_, &ws_.audit);
+
+  // (1) ODE takes the state; moments take world positions (and permanent moments their
+  //     world orientation) from their bodies
+  {
+    ScopedTimer t(&prof.sync_ms);
+    ode_->write_state(state_);
+    if (inject_body_ >= 0) ode_->set_velocity(inject_body_, inject_velocity_);
+    place_moments(m, state_, &moments_);
+  }
+
+  const double h = m.options.dt / nsub;
+  prof.substeps = nsub;
+  for (int k = 0; k < nsub; ++k) {
+    if (k > 0) {  // later sub-steps: the moments follow the bodies ODE has moved
+      ScopedTimer t(&prof.sync_ms);
+      ode_->read_state(&ws_.next);
+      place_moments(m, ws_.next, &moments_);
+      // energy audit of the sub-step just taken (its forces are still in ws_)
+      audit_substep(m, k == 1 ? state_ : ws_.sub_prev, ws_.next, ws_.body_force,
+                    ws_.body_torque, ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
+      ws_.sub_prev = ws_.next;
+    }
+    const State& now = k == 0 ? state_ : ws_.next;
+
+    // (2), (3): the first sub-step takes the forces the last step left for this state (or,
+    // after a restore or rollback, evaluates them from its converged magnetization)
+    if (k > 0 || !ws_.forces_ready) solve_magnetics(k > 0 || !state_.magnetized, n);
+    if (k == 0) ws_.coenergy_start = coenergy();
+    ws_.forces_ready = false;  // the moments move on from here
+
+    if (m.dynamic_moments) {
+      ScopedTimer t(&prof.T_f);
+      apply_magnetic_forces(m, moments_, &ws_, ode_.get());
+      // (3b) the eddy-current loss of conducting bodies (off unless the scene sets σ)
+      apply_eddy_losses(m, moments_, now, h, &ws_, ode_.get());
+    }
+
+    // (4) collide and step the rigid bodies over h
+    {
+      ScopedTimer t(&prof.T_r);
+      {
+        ScopedTimer c(&prof.collide_ms);
+        ode_->update_margins(now, ws_.body_force, h);
+        prof.contacts = ode_->collide(&ws_.next.contact_pairs, h);
+      }
+      ScopedTimer q(&prof.quickstep_ms);
+      try {
+        // the first sub-step keeps the seed of an unsplit step
+        ode_->quickstep(static_cast<unsigned long>(n) ^ (static_cast<unsigned long>(k) << 40), h);
+      } catch (const OdeFailure& e) {
+        // name the body that went bad when there is one, else report ODE's own words
+        ode_->read_state(&ws_.next);
+        check_bodies(m, ws_.next, n);
+        throw SimulationError(n, -1, "", "rigid step",
+                              "step " + std::to_string(n) + ": rigid step failed: " + e.what());
+      }
+    }
+  }
+
+  // read back and check the end state
+  State& next = ws_.next;
+  {
+    ScopedTimer t(&prof.check_ms);
+    ode_->read_state(&next);
+    next.step = n;
+    check_bodies(m, next, n);
+    next.dvel.resize(m.nbody);
+    for (int b = 0; b < m.nbody; ++b) next.dvel[b] = next.vel[b] - state_.vel[b];
+    // energy audit: the work of the last ODE step (O(bodies)), with the forces it was given
+    audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque,
+                  ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
+  }
+  // (2)+(3) at the end state: its converged magnetization, U*, and the next step's forces
+  {
+    ScopedTimer t(&prof.sync_ms);
+    place_moments(m, next, &moments_);
+  }
+  solve_magnetics(true, n);
+  store_magnetization(moments_, &next);
+  next.magnetized = true;
+  // the load term of the next step's sub-steps: |Σ F_j|/m_b of the forces it starts with
+  next.mag_accel.assign(m.nbody, 0.0);
+  if (m.dynamic_moments)
+    for (int b : m.dynamic_bodies) {
+      Vec3 F = Vec3::Zero();
+      for (int j = m.body_moment_adr[b]; j < m.body_moment_adr[b] + m.body_moment_num[b]; ++j) F += ws_.F[j];
+      next.mag_accel[b] = F.norm() / m.body_mass[b];
+    }
+  ws_.audit.magnetic_energy = coenergy();
+}
+
 void Simulation::step() {
   const Model& m = *model_;
   profile_ = StepProfile{};
-  StepProfile& prof = profile_;
-  ScopedTimer total(&prof.total_ms);
+  ScopedTimer total(&profile_.total_ms);
   const long n = state_.step + 1;  // the step being taken, as named in errors
   const OmpThreadScope threads(omp_threads_);  // several Simulations may differ
-
-  // energy audit (energy.hpp) of this step, committed with the state
-  begin_audit_step(energy_, &ws_.audit);
+  const SimOptions& o = m.options;
+  const bool guard = o.energy_guard && force_conservative(o);
 
   try {
-    // (1) ODE takes the state; moments take world positions (and permanent moments their
-    //     world orientation) from their bodies
-    {
-      ScopedTimer t(&prof.sync_ms);
-      ode_->write_state(state_);
-      if (inject_body_ >= 0) {
-        ode_->set_velocity(inject_body_, inject_velocity_);
-        inject_body_ = -1;
-      }
-      place_moments(m, state_, &moments_);
-    }
-
     // (1b) the frame's rigid sub-steps (1 unless the scene allows more and bodies move fast)
-    const int nsub = choose_substeps(m, state_);
-    const double h = m.options.dt / nsub;
-    prof.substeps = nsub;
-    for (int k = 0; k < nsub; ++k) {
-      if (k > 0) {  // later sub-steps: the moments follow the bodies ODE has moved
-        ScopedTimer t(&prof.sync_ms);
-        ode_->read_state(&ws_.next);
-        place_moments(m, ws_.next, &moments_);
-        // energy audit of the sub-step just taken (its forces are still in ws_)
-        audit_substep(m, k == 1 ? state_ : ws_.sub_prev, ws_.next, ws_.body_force,
-                      ws_.body_torque, ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
-        ws_.sub_prev = ws_.next;
+    int nsub = choose_substeps(m, state_);
+    long retakes = 0, unresolved = 0;
+    for (;;) {
+      attempt(nsub, n);
+      // the energy guard: ΔE = E_end − E_start of the whole frame, E = K + U_g + U*
+      const double e_start = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
+      const double dE = total_energy(ws_.audit) - e_start;
+      const double tol = o.energy_guard_tolerance *
+                             (energy_.kinetic + ws_.audit.kinetic + std::abs(ws_.coenergy_start)) +
+                         o.energy_guard_floor;
+      ws_.audit.last.energy_created = std::max(0.0, dE);
+      ws_.audit.last.energy_dissipated = std::max(0.0, -dE);
+      if (!guard || !(dE > tol)) break;
+      if (nsub >= o.energy_guard_max_substeps) {
+        ++unresolved;
+        break;
       }
-      const State& now = k == 0 ? state_ : ws_.next;
-
-      // (2) magnetization dynamics on the Δt_m clock, warm-started from the last (sub-)step
-      {
-        ScopedTimer t(&prof.T_i);
-        magnetize(m, &moments_, &ws_, &prof);
-      }
-      check_magnetization(m, moments_, n);
-
-      // (3) forces (eq. 4 or eqs. 13–14) and torques on the dynamic bodies
-      if (m.dynamic_moments) {
-        ScopedTimer t(&prof.T_f);
-        compute_magnetic_forces(m, moments_, &ws_);
-        check_forces(m, ws_, n);
-        apply_magnetic_forces(m, moments_, &ws_, ode_.get());
-        // (3b) the eddy-current loss of conducting bodies (off unless the scene sets σ)
-        apply_eddy_losses(m, moments_, now, h, &ws_, ode_.get());
-      }
-
-      // (4) collide and step the rigid bodies over h
-      {
-        ScopedTimer t(&prof.T_r);
-        {
-          ScopedTimer c(&prof.collide_ms);
-          ode_->update_margins(now, ws_.body_force, h);
-          prof.contacts = ode_->collide(&ws_.next.contact_pairs, h);
-        }
-        ScopedTimer q(&prof.quickstep_ms);
-        try {
-          // the first sub-step keeps the seed of an unsplit step
-          ode_->quickstep(static_cast<unsigned long>(n) ^ (static_cast<unsigned long>(k) << 40), h);
-        } catch (const OdeFailure& e) {
-          // name the body that went bad when there is one, else report ODE's own words
-          ode_->read_state(&ws_.next);
-          check_bodies(m, ws_.next, n);
-          throw SimulationError(n, -1, "", "rigid step",
-                                "step " + std::to_string(n) + ": rigid step failed: " + e.what());
-        }
-      }
+      // retake the frame from state_ in twice as many sub-steps
+      ++retakes;
+      rollback();
+      nsub = std::min(2 * nsub, o.energy_guard_max_substeps);
     }
+    profile_.guard_retakes = static_cast<int>(retakes);
+    ws_.audit.guard_retakes += retakes;
+    ws_.audit.guard_unresolved += unresolved;
+    ws_.audit.total.energy_created += ws_.audit.last.energy_created;
+    ws_.audit.total.energy_dissipated += ws_.audit.last.energy_dissipated;
+    if (energy_.substeps == 0)  // the audit's first step: E at its start
+      ws_.audit.initial_total = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
 
-    // read back, check, commit
-    {
-      ScopedTimer t(&prof.check_ms);
-      State& next = ws_.next;
-      ode_->read_state(&next);
-      store_magnetization(moments_, &next);
-      next.step = n;
-      check_bodies(m, next, n);
-      next.dvel.resize(m.nbody);
-      for (int b = 0; b < m.nbody; ++b) next.dvel[b] = next.vel[b] - state_.vel[b];
-      next.mag_accel.assign(m.nbody, 0.0);
-      if (m.dynamic_moments)
-        for (int b : m.dynamic_bodies) next.mag_accel[b] = ws_.body_force[b].norm() / m.body_mass[b];
-      // energy audit: the work of the last ODE step (O(bodies)); U_mag from the forces' field
-      audit_substep(m, nsub == 1 ? state_ : ws_.sub_prev, next, ws_.body_force, ws_.body_torque,
-                    ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
-      // the potential of the force where it has one (zeeman-total: E_sys, forces.hpp)
-      ws_.audit.magnetic_energy =
-          m.options.force_model == ForceChoice::ZeemanTotal && ws_.mag.H.size() == moments_.size()
-              ? mag::zeeman_total_energy(moments_, mag::curve_of(m.options.method), ws_.mag.H,
-                                         ws_.mag.total.perm, ws_.mag.total.Hp)
-              : magnetic_energy(moments_, ws_.mag.H);
-      std::swap(energy_, ws_.audit);
-      std::swap(state_, next);
-      place_moments(m, state_, &moments_);  // moments() follows the new poses
-    }
+    // commit
+    std::swap(energy_, ws_.audit);
+    std::swap(state_, ws_.next);
+    ws_.forces_ready = true;
+    inject_body_ = -1;
   } catch (const SimulationError&) {
+    inject_body_ = -1;
     rollback();
     throw;
   } catch (const OdeFailure& e) {  // ODE failed outside the step (e.g. in collision)
     ode_->mark_broken();
+    inject_body_ = -1;
     rollback();
     throw SimulationError(n, -1, "", "rigid step",
                           "step " + std::to_string(n) + ": ODE failed: " + e.what());

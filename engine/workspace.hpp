@@ -32,6 +32,11 @@ struct Workspace {
   double eddy_h = 0.0;
   std::vector<Vec3> eddy_force;
   std::vector<Vec3> eddy_torque;
+  /// F, tau and mag.H/J hold the forces of the committed state's poses and magnetization
+  /// (computed at the end of the step that made it): the next step's first sub-step uses
+  /// them. Cleared by a rollback or a restore.
+  bool forces_ready = false;
+  double coenergy_start = 0.0;    ///< U* (J) at the start of the step being taken
   State sub_prev;                 ///< the state after the last sub-step (energy audit)
   State next;                     ///< the state being computed; swapped in when it checks out
   EnergyAudit audit;              ///< the energy audit being computed, committed with next

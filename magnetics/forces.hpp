@@ -27,6 +27,18 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// Induced: the model's force, no torque (M ∥ H). Permanent: F = μ0 J m, τ = μ0 m × H.
 /// F_classic (optional) receives the classic force of every moment as well.
 ///
+/// Classic, bodies of several moments (a group of ≥ 2): the moments of a group exert no force
+/// on each other, but rotating the body at fixed induced M (the envelope theorem's variation,
+/// coenergy.hpp) changes their pair energy by −δθ·μ0 Σ_induced m_j × H_j^same, H^same the field
+/// of the moment's own group. The torques that make the body's torque exactly −∂U*/∂θ:
+///   τ_j = μ0 m_j × (H_j − H_j^same)   (permanent: the field of the other bodies and H0),
+///   τ_j = −μ0 m_j × H_j^same          (induced: the shape anisotropy of a letter).
+/// With one moment per body H^same = 0 and these are the torques above.
+/// Classic with bounded pairs (FieldOptions::bounded_pairs): the clamped pair energy's
+/// gradient, F_j = μ0 Σ_i (∂r_b/∂r)ᵀ J(r_b) m_j, ∂r_b/∂r = (R/|r|)(I − r̂ r̂ᵀ) inside the bound:
+/// no pull deeper into an overlap, so the force stays −∇U* (the field, and so U*, is the
+/// clamped one already). eq. 4 keeps the clamp of the force (not a gradient there).
+///
 /// reaction_symmetric (Zeeman only): the Zeeman force on j is the classic pair force with m_j
 /// replaced by the effective moment m̃_j = V_j [A_j(2M_j + H_j) + M_j] (m̃ = m for permanent
 /// moments), so per pair it is F_{j←i} = μ0 J(r_ji; m_i) m̃_j and F_{i←j} ≠ −F_{j←i}: the

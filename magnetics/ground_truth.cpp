@@ -27,6 +27,12 @@ Problem build(const MomentSet& set, const FieldOptions& field) {
     if (set.kind[j] == MomentKind::Induced) P.idx.push_back(static_cast<int>(j));
   const int k = static_cast<int>(P.idx.size());
   const double eps2 = field.softening * field.softening;
+  // pairs as compute_fields sums them: softened, and clamped to their bound (bounded pairs)
+  const bool bounded = pairs_bounded(set, field);
+  auto sep = [&](std::size_t j, std::size_t i) {
+    const Vec3 r = set.position[j] - set.position[i];
+    return bounded ? bounded_separation(r, set.radius[i] + set.radius[j]) : r;
+  };
   P.Hb.resize(3 * k);
   P.T.setZero(3 * k, 3 * k);
   const double inv4pi = 1.0 / (4.0 * kPi);
@@ -35,12 +41,12 @@ Problem build(const MomentSet& set, const FieldOptions& field) {
     Vec3 hb = set.H0;
     for (std::size_t i = 0; i < set.size(); ++i)
       if (set.kind[i] == MomentKind::Permanent)
-        hb += dipole_field(set.position[j] - set.position[i], set.m_perm[i], eps2);
+        hb += dipole_field(sep(j, i), set.m_perm[i], eps2);
     P.Hb.segment<3>(3 * a) = hb;
     for (int b = 0; b < k; ++b) {
       if (a == b) continue;
       const int i = P.idx[b];
-      const Vec3 r = set.position[j] - set.position[i];
+      const Vec3 r = sep(j, i);
       const double q = r.squaredNorm() + eps2;
       const double inv = 1.0 / std::sqrt(q);
       const double inv3 = inv * inv * inv;

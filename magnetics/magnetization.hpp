@@ -94,6 +94,9 @@ struct MagWorkspace {
   std::vector<Vec3> H_eff_src;  ///< (n) field of the effective moments (scratch)
   std::vector<Mat3> J_eff_src;  ///< (n) its Jacobian (scratch)
   std::vector<Mat3> A;  ///< (n) scratch for the Newton solver
+  std::vector<int> group_order;  ///< scratch: moments sorted by group (classic torques)
+  /// scratch: (grid cell, moment) of the bounded moments (classic force, bounded pairs)
+  std::vector<std::pair<std::uint64_t, int>> bounded_cells;
   AndersonHistory anderson;  ///< Method::Anderson only
   ZeemanTotalScratch total;  ///< ForceModel::ZeemanTotal only
 };

@@ -39,9 +39,17 @@ enum class ForceModel : std::uint8_t {
 
 /// The curve a method converges to (Kim 2018 uses eq. 7, every other method eq. 10).
 inline Curve curve_of(Method m) { return m == Method::Kim2018 ? Curve::Kim : Curve::Tanh; }
-/// The force model a method is paired with (the paper's pairing).
+/// The force model a method is paired with: eq. 4 for the paper's θ dynamics and the
+/// damping-only LLG (ours, ours-realigned, damping-llg: the paper's pairing); the classic force
+/// for Kim 2018 and for the converged solves (anderson, exact), where it is −∇U* of the
+/// co-energy (coenergy.hpp) and the engine's default.
 inline ForceModel force_model_of(Method m) {
-  return m == Method::Kim2018 ? ForceModel::Classic : ForceModel::Zeeman;
+  switch (m) {
+    case Method::Kim2018:
+    case Method::Anderson:
+    case Method::Exact: return ForceModel::Classic;
+    default: return ForceModel::Zeeman;
+  }
 }
 
 /// "ours", "ours-realigned", "kim2018", "damping-llg", "exact", "anderson".

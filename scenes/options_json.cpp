@@ -95,6 +95,10 @@ json to_json(const SimOptions& o) {
               {"reaction_symmetric_forces", o.reaction_symmetric_forces},
               {"balance_magnetic_torque", o.balance_magnetic_torque},
               {"force_model", engine::force_choice_name(o.force_model)},
+              {"energy_guard", o.energy_guard},
+              {"energy_guard_tolerance", o.energy_guard_tolerance},
+              {"energy_guard_floor", o.energy_guard_floor},
+              {"energy_guard_max_substeps", o.energy_guard_max_substeps},
               {"max_substeps", o.max_substeps},
               {"substep_reach", o.substep_reach},
               {"substep_load", o.substep_load},
@@ -155,7 +159,8 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "bh_theta", "bh_threshold", "magnetics", "force_model", "max_substeps", "substep_reach",
                    "substep_load", "rolling_friction", "rolling_friction_bodies", "eddy_conductivity",
                    "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
-                   "bh_near_float", "bh_far_float"});
+                   "bh_near_float", "bh_far_float", "energy_guard", "energy_guard_tolerance",
+                   "energy_guard_floor", "energy_guard_max_substeps"});
   if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   if_present(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.number(v, p);
@@ -181,6 +186,10 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
     const std::string s = r.string(v, p);
     if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic, zeeman-total)");
   });
+  if_present(j, "energy_guard", path, [&](const json& v, const std::string& p) { o->energy_guard = r.boolean(v, p); });
+  if_present(j, "energy_guard_tolerance", path, [&](const json& v, const std::string& p) { o->energy_guard_tolerance = r.non_negative(v, p); });
+  if_present(j, "energy_guard_floor", path, [&](const json& v, const std::string& p) { o->energy_guard_floor = r.non_negative(v, p); });
+  if_present(j, "energy_guard_max_substeps", path, [&](const json& v, const std::string& p) { o->energy_guard_max_substeps = r.integer(v, p, 1, 64); });
   if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = r.integer(v, p, 1, 64); });
   if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.positive(v, p); });
   if_present(j, "substep_load", path, [&](const json& v, const std::string& p) { o->substep_load = r.boolean(v, p); });

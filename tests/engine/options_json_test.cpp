@@ -60,6 +60,10 @@ SimOptions all_changed() {
   o.rolling_friction = 1e-3;
   o.rolling_friction_bodies = 4e-4;
   o.eddy_conductivity = 6.5e6;
+  o.energy_guard = false;
+  o.energy_guard_tolerance = 2.5e-4;
+  o.energy_guard_floor = 3e-8;
+  o.energy_guard_max_substeps = 17;
   o.restitution = 0.2;
   o.erp = 0.35;
   o.cfm = 2e-8;
@@ -120,6 +124,10 @@ void check_equal(const SimOptions& a, const SimOptions& b) {
   CHECK(a.rolling_friction == b.rolling_friction);
   CHECK(a.rolling_friction_bodies == b.rolling_friction_bodies);
   CHECK(a.eddy_conductivity == b.eddy_conductivity);
+  CHECK(a.energy_guard == b.energy_guard);
+  CHECK(a.energy_guard_tolerance == b.energy_guard_tolerance);
+  CHECK(a.energy_guard_floor == b.energy_guard_floor);
+  CHECK(a.energy_guard_max_substeps == b.energy_guard_max_substeps);
   CHECK(a.restitution == b.restitution);
   CHECK(a.erp == b.erp);
   CHECK(a.cfm == b.cfm);
@@ -149,7 +157,7 @@ SimOptions read_back(const nlohmann::json& j) {
 // all_changed and check_equal above (and SCENE_FILE.md), then update the size here.
 static_assert(sizeof(mag::FieldOptions) == 48, "FieldOptions changed: extend scenes/options_json.cpp");
 static_assert(sizeof(mag::DynamicsOptions) == 152, "DynamicsOptions changed: extend scenes/options_json.cpp");
-static_assert(sizeof(SimOptions) == 376, "SimOptions changed: extend scenes/options_json.cpp");
+static_assert(sizeof(SimOptions) == 408, "SimOptions changed: extend scenes/options_json.cpp");
 
 TEST_CASE("options_json: every field, away from its default, survives to_json and from_json", "[options_json]") {
   const SimOptions o = all_changed();

@@ -63,7 +63,7 @@ TEST_CASE("anderson is a method: name, curve, force model", "[anderson]") {
   CHECK(m == Method::Anderson);
   CHECK(std::string(method_name(Method::Anderson)) == "anderson");
   CHECK(curve_of(Method::Anderson) == Curve::Tanh);
-  CHECK(force_model_of(Method::Anderson) == ForceModel::Zeeman);
+  CHECK(force_model_of(Method::Anderson) == ForceModel::Classic);  // converged: −∇U*
   DynamicsOptions o;
   o.method = Method::Anderson;
   CHECK(validate(o).empty());

@@ -66,6 +66,10 @@ struct Args {
   double rolling_friction = 0.0;
   double rolling_friction_bodies = 0.0;
   double eddy_conductivity = 0.0;
+  std::string energy_guard;
+  double energy_guard_tolerance = 0.0;
+  double energy_guard_floor = 0.0;
+  int energy_guard_max_substeps = 0;
   double quickstep_w = 0.0;
   double dt = 0.0;
   std::string bounded_pairs;

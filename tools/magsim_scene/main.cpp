@@ -94,6 +94,10 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
   if (app.count("--rolling-friction-bodies")) s.options.rolling_friction_bodies = a.rolling_friction_bodies;
   if (app.count("--eddy-conductivity")) s.options.eddy_conductivity = a.eddy_conductivity;
+  if (app.count("--energy-guard")) s.options.energy_guard = on_off("--energy-guard", a.energy_guard);
+  if (app.count("--energy-guard-tolerance")) s.options.energy_guard_tolerance = a.energy_guard_tolerance;
+  if (app.count("--energy-guard-floor")) s.options.energy_guard_floor = a.energy_guard_floor;
+  if (app.count("--energy-guard-max-substeps")) s.options.energy_guard_max_substeps = a.energy_guard_max_substeps;
   if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
   if (app.count("--dt")) s.options.dt = a.dt;
   if (app.count("--bounded-pairs"))
@@ -152,7 +156,11 @@ int main(int argc, char** argv) {
                "moments.csv"};
   Args a;
   app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
-  app.add_option("--method", a.method, scenes::method_list(" | ") + " (default: the scene's, ours-realigned)")
+  app.add_option("--method", a.method,
+                 scenes::method_list(" | ") +
+                     " (default: the scene's, anderson: M = f(H(M)) converged every sub-step, with the classic "
+                     "force, -grad of the co-energy U*; ours = the paper as printed: theta dynamics eqs. 8-11 and "
+                     "eq. 4, which has no energy; kim2018 = the baseline)")
       ->check(CLI::IsMember(scenes::method_names()));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(kFinitePositive);
@@ -179,9 +187,23 @@ int main(int argc, char** argv) {
   app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   app.add_option("--force-model", a.force_model,
-                 "force on induced moments: method (the method's own: classic for kim2018, eq. 4 "
-                 "otherwise) | zeeman (eq. 4) | classic (eqs. 13-14) | zeeman-total (eq. 4 as the gradient "
-                 "of the system's Zeeman energy: conservative) (default: the scene's, method)");
+                 "force on induced moments: method (the method's own: classic for anderson, exact and kim2018, "
+                 "eq. 4 for ours, ours-realigned and damping-llg) | zeeman (eq. 4, not the gradient of any energy) "
+                 "| classic (eqs. 13-14, -grad U* with converged magnetizations) | zeeman-total (eq. 4 as the "
+                 "gradient of the system's Zeeman energy: conservative) (default: the scene's, method)");
+  app.add_option("--energy-guard", a.energy_guard,
+                 "on | off: retake a rigid step in twice the sub-steps when E = K + U_g + U* rises by more than "
+                 "the tolerance (default on; unavailable for eq. 4 (zeeman), which has no energy: never applied "
+                 "there, summary.json energy.guard says so)");
+  app.add_option("--energy-guard-tolerance", a.energy_guard_tolerance,
+                 "the guard's tolerance relative to the step's K_start + K_end + |U*_start| (default 1e-3)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--energy-guard-floor", a.energy_guard_floor,
+                 "the guard's absolute tolerance per step, J (default 1e-6)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--energy-guard-max-substeps", a.energy_guard_max_substeps,
+                 "most sub-steps the guard retakes a frame in (default 32)")
+      ->check(CLI::Range(1, 64));
   app.add_option("--max-substeps", a.max_substeps,
                  "most rigid sub-steps per frame; a frame is split when bodies touching each other move fast or bodies "
                  "in contact are pressed hard by the magnetic force (1 = never; default: the scene's)")

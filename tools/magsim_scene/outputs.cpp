@@ -58,7 +58,9 @@ json energy_flow_json(const engine::EnergyFlow& f) {
               {"eddy_work", f.eddy_work},
               {"contact_work", f.contact_work},
               {"gravity_drift", f.gravity_drift},
-              {"contact_work_in", f.contact_work_in}};
+              {"contact_work_in", f.contact_work_in},
+              {"energy_created", f.energy_created},
+              {"energy_dissipated", f.energy_dissipated}};
 }
 
 }  // namespace
@@ -87,6 +89,22 @@ json energy_json(const engine::Simulation& sim) {
   j["initial_kinetic"] = e.initial_kinetic;
   j["initial_gravitational"] = e.initial_gravitational;
   j["magnetic_energy"] = e.magnetic_energy;
+  // E = K + U_g + U*, what the steps created and dissipated of it (energy.hpp)
+  j["total"] = engine::total_energy(e);
+  j["initial_total"] = e.initial_total;
+  j["created"] = e.total.energy_created;
+  j["dissipated"] = e.total.energy_dissipated;
+  const engine::SimOptions& o = sim.model().options;
+  const bool conservative = engine::force_conservative(o);
+  j["conservative"] = conservative;
+  j["guard"] = {{"enabled", o.energy_guard && conservative},
+                {"available", conservative},
+                {"note", conservative ? "" : "unavailable: eq. 4 (zeeman) is not the gradient of any energy"},
+                {"tolerance", o.energy_guard_tolerance},
+                {"floor", o.energy_guard_floor},
+                {"max_substeps", o.energy_guard_max_substeps},
+                {"retakes", e.guard_retakes},
+                {"unresolved", e.guard_unresolved}};
   j["substeps"] = e.substeps;
   j["last_step"] = energy_flow_json(e.last);
   return j;

@@ -129,6 +129,10 @@ class Recorder {
     series_["energy_gravity_drift"].push_back(e.total.gravity_drift);
     series_["energy_step_magnetic_work"].push_back(e.last.magnetic_work);
     series_["energy_step_contact_work"].push_back(e.last.contact_work);
+    series_["energy_total"].push_back(engine::total_energy(e));
+    series_["energy_created"].push_back(e.total.energy_created);
+    series_["energy_dissipated"].push_back(e.total.energy_dissipated);
+    series_["guard_retakes"].push_back(e.guard_retakes);
     return true;
   }
   int frames() const { return frames_; }
