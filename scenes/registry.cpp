@@ -22,7 +22,9 @@ namespace {
 using mag::kPi;  // magnetics/types.hpp
 constexpr double kIronMs = 1.6e6;        // saturation magnetization of iron (A/m)
 constexpr double kIronDensity = 7870.0;  // (kg/m³)
-constexpr double kNdFeBM = 1.0e6;        // magnetization of a neodymium magnet, Br ≈ 1.26 T (A/m)
+// magnetization of an N52 neodymium magnet, Br ≈ 1.43 T (A/m): a cube of side s carries
+// 1.1e6 · s³ A·m², a sphere of radius R 1.1e6 · 4/3 π R³
+constexpr double kN52M = 1.1e6;
 // rolling resistance ρ = c_rr · r of balls on the ground and the tree (falling_magnet states
 // the measurements that chose it), and in sakura_tree of a ball on a ball
 constexpr double kRollingCoefficient = 0.2;
@@ -91,8 +93,10 @@ constexpr double kStackGap = 0.001;
 constexpr int kBallsUpSide = 9;    // balls per row (9 × 9 per layer, the paper's 9×9×3)
 constexpr int kBallsUpLayers = 3;  // the paper's layers: the magnet's height is set from them
 
-// balls_up — 243 iron balls (9×9×3, radius 5 mm) resting on frictionless ground; a 2 cm
-// neodymium cube magnet fixed 3 cm above the top layer pulls them up.
+// balls_up — 243 iron balls (9×9×3, radius 5 mm) resting on frictionless ground; a 3 cm
+// N52 cube magnet (29.7 A·m², 1.1e6 A/m · (3 cm)³) fixed 3 cm above the top layer pulls them
+// up. Sized for the classic force (the default): the paper's 2 cm cube (8.8 A·m²) lifts one
+// ball under it, 3 cm holds 140–155 (tools/findings/balls_up.md).
 SceneDesc balls_up(const SceneParams& p) {
   SceneDesc s;
   s.name = "balls_up";
@@ -103,24 +107,17 @@ SceneDesc balls_up(const SceneParams& p) {
   const int N = p.count > 0 ? p.count : 243;
   const double r = 0.005;
   stack_balls(&s, N, kBallsUpSide, r, kStackGap, 0, 0);
-  const double L = 0.02;  // cube side (m)
+  const double L = 0.03;  // cube side (m)
   // the magnet's face 3 cm above the paper's 3 layers (--count leaves it there: fewer balls
-  // only lie lower, and the stress sweep's 54 balls keep their measured setting)
+  // only lie lower)
   const double face = kBallsUpLayers * 2 * r + 0.03;  // (m)
   s.bodies.push_back(magnet_body("magnet", BodyType::Static, Vec3(0, 0, face + L / 2), ShapeKind::Box,
                                  Vec3(L / 2, L / 2, L / 2),
-                                 {permanent_moment(L * L * L, Vec3(0, 0, kNdFeBM * L * L * L * p.strength))}));  // 8 A·m², up
+                                 {permanent_moment(L * L * L, Vec3(0, 0, kN52M * L * L * L * p.strength))}));  // 29.7 A·m², up
   s.options.friction = 0.0;
   s.options.quickstep_iterations = 100;
   // up to 8 rigid sub-steps per frame where bodies in contact move fast (the motion term
-  // only: the load term would split every frame, 7.9 sub-steps per frame on the resting
-  // pile). 2 s: 0 balls beyond 15 cm instead of 1, final KE 2.1e-5 J instead of 0.016, the
-  // fastest ball of the last second 0.20 m/s instead of 2.8; 1.27 sub-steps per frame,
-  // median step 3.98 ms against 4.01, wall 10.4 s against 8.5. Without them the robustness
-  // matrix (tools/robustness.sh, 1 s, 20 or 50 QuickStep iterations instead of these 100)
-  // broke 20 m/s in 16 of 24 runs, among them W 1.3, 20 iterations, 1 ms, ×1 (81 m/s, 237
-  // balls thrown) and every run at ×3 but one; with them in none (peaks at 60 fps 4.4–17.9
-  // m/s, final KE ≤ 0.69 J).
+  // only: the load term would split every frame of the resting pile)
   s.options.max_substeps = 8;
   s.options.substep_load = false;
   s.camera.eye = Eigen::Vector3f(0.16f, -0.20f, 0.12f);
@@ -134,25 +131,13 @@ SceneDesc balls_up(const SceneParams& p) {
 // ---------------------------------------------------------------------------------------
 // alphabets — 100 letter pieces (iron, 3 cm tall, 5 mm strokes, 1 induced moment per
 // stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible, "excessively strong"
-// 300 A·m² moment at the grid centre with an invisible collider of radius 2 cm. Where a
-// stroke lies on the collider its moment is 2.25 cm from the centre: |H| = 2m/(4π r³) =
-// 4.2 MA/m = 2.6 Ms on the axis, inside Fig. 9's region |H| ≥ 2.5 Ms where Kim 2018's
-// dynamics fails (issue #12). Letters arrive at up to 15 m/s and a 1 ms frame does not
-// resolve that: in one ODE step per frame every force model blew up (ours-realigned 1267 m/s
-// at step 300, the classic force 4019 m/s at step 401). The frame is therefore split into
-// up to 16 rigid sub-steps where bodies in contact move fast or are pressed hard into their
-// contacts (substep_reach 0.25 of the 2.5 mm stroke half-width; the load term asks 13 for
-// letters pressed onto the collider at ~10⁵ m/s²). Measured, 2 s, 1 thread: all 100
-// letters held, none beyond 0.3 m; fastest letter 15 m/s (gathering), 0.41 m/s in the last
-// second, 0.05 m/s at the end; 13.2 sub-steps per frame on average, the magnetization at its
-// cap in 35 of 2000 frames, median T_i 9.1 + T_f 1.7 + T_r 79 ms per frame (the paper's T_r:
-// 110 ms; the code before both fixes 42 + 0.7 + 82, run side by side). `--strength 3` (900 A·m²):
-// 100 held, 0.20 m/s in the last second, 16 sub-steps. Without the load term (`substep_load`
-// false: 5.8 sub-steps per frame): 3.0 m/s in the last second, 0.67 at the end, the cap in
-// 1531 frames. Kim 2018 with the same sub-steps also holds all 100 but keeps them moving:
-// 3.1 m/s in the last second, the cap in 1866 frames; Fig. 4-(c)'s blow-up does not
-// reproduce. `--strength 0.1` gives the earlier 30 A·m² scene (without sub-steps it threw 2
-// letters out, 67 held, 4.3 m/s at 2 s).
+// 300 A·m² moment at the grid centre with an invisible collider of radius 2 cm (the paper's
+// fiction: no real magnet of that size carries it; an N52 sphere of 300 A·m² would have a
+// radius of 4.4 cm). Where a stroke lies on the collider its moment is 2.25 cm from the
+// centre: |H| = 2m/(4π r³) = 4.2 MA/m = 2.6 Ms on the axis, inside Fig. 9's region
+// |H| ≥ 2.5 Ms where Kim 2018's dynamics fails. Letters arrive at up to 15 m/s, so the frame
+// splits into up to 16 rigid sub-steps where bodies in contact move fast or are pressed hard
+// into their contacts (tools/findings/alphabets.md).
 struct Stroke {
   double x0, y0, x1, y1;  // glyph units: width 2, height 3
 };
@@ -238,8 +223,10 @@ SceneDesc alphabets(const SceneParams& p) {
 }
 
 // ---------------------------------------------------------------------------------------
-// falling_magnet — 1032 iron balls (radius 5 mm) stacked 12×12 per layer; a heavy sphere
-// magnet (radius 2 cm, NdFeB, 33.5 A·m², 0.25 kg) falls onto them from 8 cm above the top.
+// falling_magnet — 1032 iron balls (radius 5 mm) stacked 12×12 per layer; a heavy N52
+// sphere magnet (radius 2.2 cm, 49 A·m² = 1.1e6 A/m · 4/3 π (2.2 cm)³, 0.33 kg) falls onto
+// them from 8 cm above the top. Sized for the classic force (the default): the 2 cm magnet of
+// 33.5 A·m² that eq. 4 needed holds under 600 balls with it (tools/findings/falling_magnet.md).
 SceneDesc falling_magnet(const SceneParams& p) {
   SceneDesc s;
   s.name = "falling_magnet";
@@ -253,58 +240,28 @@ SceneDesc falling_magnet(const SceneParams& p) {
   stack_balls(&s, N, side, r, kStackGap, 0, 0);
   const int layers = (N + side * side - 1) / (side * side);
   const double top = layers * 2 * r * (1.0 + kStackGap);
-  const double R = 0.02;
+  const double R = 0.022;  // (m)
   // 8 cm above the pile, a few mm off the central column: it lands between balls, not on
   // one ball's top (a symmetric landing would be a knife-edge start)
   const Vec3 drop(0.004, -0.003, top + 0.08 + R);  // (m)
   BodyDesc mag = magnet_body("magnet", BodyType::Dynamic, drop, ShapeKind::Sphere, Vec3(R, R, R),
-                             {permanent_moment(sphere_volume(R), Vec3(0, 0, -kNdFeBM * sphere_volume(R) * p.strength))});  // pointing down
+                             {permanent_moment(sphere_volume(R), Vec3(0, 0, -kN52M * sphere_volume(R) * p.strength))});  // 49 A·m², down
   mag.density = 7500.0;  // NdFeB (kg/m³)
   s.bodies.push_back(mag);
-  // a dynamic magnet: eq. 4's forces do not balance pairwise, and the magnet with the balls
-  // on it would propel itself (200 m/s within 1 s); apply them pairwise antisymmetrized
+  // eq. 4 (--method ours) breaks action = reaction: with a dynamic magnet the magnet and its
+  // balls would propel themselves, so its forces are applied pairwise antisymmetrized (no
+  // effect on the classic force, which balances already)
   s.options.reaction_symmetric_forces = true;
   // rolling resistance on the ground, ρ = 0.2 r (c_rr = 0.2, a ball on a soft mat): without
-  // it the collapsed block rolls away for ever (no magnetism, 2 s: 720 balls beyond 0.2 m,
-  // 0.69 m/s at the end, final KE 0.13 J); with it the same control rests (7 beyond 0.2 m,
-  // none beyond 1 m, final KE 7.8e-6 J).
+  // it the collapsed block of balls rolls away for ever
   s.options.rolling_friction = kRollingCoefficient * r;
-  // 50 QuickStep iterations (ODE's 20 elsewhere): at 20 the heap does not stop creeping.
-  // Control (no magnetism, 2 s, 4 runs with 1032…1029 balls), fastest ball in the last
-  // second at 50 fps: 0.21 0.32 0.06 0.07 m/s at 20 iterations (small avalanches down the
-  // heap at 1.85 s: friction unconverged), 0.026 0.014 0.036 0.054 m/s at 50 (issue #12
-  // asks ≤ 0.1). ODE does not warm-start contacts, so every step's friction starts from 0.
-  // Cost: T_r 11–14 → 25 ms; T_i+T_f+T_r per frame 27.3 ms (122b594), 30.4 (20 iterations),
-  // 39.8 (50), mean over 400 steps, median of 3 interleaved runs, 1 thread. The magnetized
-  // run's scatter does not change (balls > 0.3 m from the magnet at 0.6 s, 6 runs: mean
-  // 16.3 at 20, 15.2 at 50, 17.0 at 80 iterations).
+  // 50 QuickStep iterations: at ODE's 20 the heap's friction does not converge and it creeps
   s.options.quickstep_iterations = 50;
-  // dipole softening ε = 2.5 mm (|r|² → |r|² + ε² in every field, Jacobian and force; half a
-  // ball radius): two touching balls pull (r²/(r²+ε²))^{5/2} = 0.86 of the point-dipole
-  // force, and a chain of balls snapping onto the magnet no longer throws its last ball off
-  // (issue #12: under eq. 4 the trailing ball kept the chain's momentum, 8 m/s). Measured,
-  // 2 s, runs with 1032/1031/1030/1029 balls: beyond 1 m of the magnet 8, 8, 7, 3 without
-  // it, 3, 1, 2, 1 with it; fastest ball in the last second 9.1, 7.4, 5.1, 1.9 m/s against
-  // 1.07, 0.71, 1.32, 2.1 (balls rolling out after the impact; 0.14–0.90 m/s at 2 s). At ×3
-  // strength and these 50 iterations it stops eq. 4's pumping of the resting pile (3 of 3
-  // runs: final KE 0.03–0.13 J against 0.65 and 11 J); at 40 iterations the softened pile
-  // still ran away (2 of 2 runs: 75 and 919 balls beyond 1 m). The control (no magnetism)
-  // is not affected. Cost: none.
+  // dipole softening ε = 2.5 mm, half a ball radius (|r|² → |r|² + ε² in every field,
+  // Jacobian and force)
   s.options.magnetics.field.softening = 0.0025;  // (m)
-  // up to 8 rigid sub-steps where bodies in contact move fast (the motion term only, as
-  // balls_up; substeps.cpp): the impact and the collapse (0.1–0.5 s) split, the resting
-  // heap does not (1.28 sub-steps per frame over 2 s). 2 s, 1032…1029 balls: beyond 1 m
-  // 1, 2, 0, 0 against 3, 1, 2, 1 in one step per frame; fastest ball in the last second
-  // 1.76, 0.83, 0.71, 0.56 m/s against 1.07, 0.71, 1.32, 2.1 (the 1.76: an avalanche at the
-  // heap's foot at 1.0 s). Cost, T_i+T_f+T_r per frame over 2 s, 1 thread, one run after
-  // another: 44.9 ms against 42.5 (29.7 for a binary from before issue #12's work: 20
-  // iterations, no softening, no sub-steps). It does not stop the ×3 / 40-iteration
-  // runaway (KE 6.5 J at 2 s and growing); the load term does (≈ 4 sub-steps a frame).
-  // Contacts with the ground no longer count for the motion term (substeps.cpp): a ball
-  // thrown off at 2.5 m/s and rolling out on the floor split every frame for a second. 1 s,
-  // 1 thread, side by side: 51.0 against 55.2 ms per frame, 1.38 sub-steps against 1.53;
-  // 2 s, 1032…1029: beyond 1 m 1, 2, 0, 0 as before, fastest ball in the last second
-  // 0.74, 0.92, 0.47, 0.30 m/s.
+  // up to 8 rigid sub-steps where bodies touching each other move fast (the impact and the
+  // collapse; the motion term only)
   s.options.max_substeps = 8;
   s.options.substep_load = false;
   s.camera.eye = Eigen::Vector3f(0.26f, -0.32f, 0.22f);
@@ -317,8 +274,10 @@ SceneDesc falling_magnet(const SceneParams& p) {
 
 // ---------------------------------------------------------------------------------------
 // sakura_tree — 2500 iron balls (radius 4 mm) fall from a 50×50 grid 40 cm up onto a static
-// tree of capsules whose 8 branch ends each carry a NdFeB sphere magnet (radius 1.2 cm,
-// 7.2 A·m², |H| = 2M/3 ≈ 0.42 Ms at its poles).
+// tree of capsules whose 8 branch ends each carry an N52 sphere magnet (radius 1.7 cm,
+// 22.6 A·m² = 1.1e6 A/m · 4/3 π (1.7 cm)³, |H| = 2M/3 ≈ 0.46 Ms at its poles). Sized for
+// the classic force (the default): the 1.2 cm magnets eq. 4 needed hold about 200 balls with
+// it, these about 390 (tools/findings/sakura_tree.md).
 SceneDesc sakura_tree(const SceneParams& p) {
   SceneDesc s;
   s.name = "sakura_tree";
@@ -358,12 +317,11 @@ SceneDesc sakura_tree(const SceneParams& p) {
       const double b = a + twig_spread * k;
       const Vec3 tip = mid + Vec3(twig_out * std::cos(b), twig_out * std::sin(b), twig_up);
       capsule(mid, tip, twig_r);
-      // the branch end: a NdFeB sphere magnet of radius Rt magnetized along the branch, a
-      // static body of its own (coloured as a magnet). Its collider keeps iron at ≥ Rt + r
-      // from the dipole: a 20 A·m² point moment on a 4 mm twig let a ball reach 8 mm from
-      // it (|H| ≈ 4 Ms, ≈ 1 kN on a 2 g ball), which no 1 ms rigid step resolves.
-      const double Rt = 0.012;  // (m)
-      const Vec3 m = kNdFeBM * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 7.2 A·m²
+      // the branch end: an N52 sphere magnet of radius Rt magnetized along the branch, a
+      // static body of its own (coloured as a magnet); its collider keeps iron at ≥ Rt + r
+      // from the dipole
+      const double Rt = 0.017;  // (m)
+      const Vec3 m = kN52M * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 22.6 A·m²
       tips.push_back(magnet_body("tip_magnet_" + std::to_string(tips.size()), BodyType::Static, tip,
                                  ShapeKind::Sphere, Vec3(Rt, Rt, Rt), {permanent_moment(sphere_volume(Rt), m)}));
     }
@@ -388,32 +346,16 @@ SceneDesc sakura_tree(const SceneParams& p) {
     s.bodies.push_back(iron_ball("ball_" + std::to_string(k), pos, r));
   }
   s.options.rolling_friction = kRollingCoefficient * r;  // as falling_magnet: balls can rest
-  // Bounded pairs (issue #12): no pair of moments is evaluated closer than the two radii
-  // summed, so two balls a QuickStep leaves overlapping at a tip are not pulled harder for
-  // it. In tools/robustness.sh (0.6 s, bound 20 m/s) point pairs broke the bound in 12 of
-  // 24 runs, 7 of them at the 1000 m/s guard (QuickStep W 1.0 at 1 ms: two balls 5.6 mm
-  // apart, 8 mm across, thrown at 94 m/s); bounded, in 4, all at Δt_r 2 ms (21–227 m/s),
-  // none at the guard, and all 16 runs at 0.5 and 1 ms stay under 15.4 m/s. 2 s, 2500…2497
-  // balls: 0, 3, 2, 3 beyond 0.5 m against 2, 4, 4, 5; fastest at 2 s 0.56–0.82 m/s
-  // against 0.41–0.66.
-  s.options.magnetics.field.bounded_pairs = true;
+  // no bounded pairs: their clamp has a kink exactly at contact, where the resting balls
+  // sit, and there E = K + U_g + U* jitters by ±0.03 J a step; without it E only falls
   // rolling resistance between two balls too (the same ρ): a ball hanging on one neighbour
-  // at a tip rolled to and fro on it without loss (500 balls, 1 s after landing: 0.1–1.7
-  // m/s and 200–800 rad/s with a 30 ms period, traced per step), and the tip clusters kept
-  // rattling (2 s: 24.5–30.7 tip balls on average moving > 1 mm between 60 fps frames in
-  // the last second, most of the final kinetic energy spin). 2 s, 2500…2497 balls: 6.3,
-  // 6.2, 15.9, 10.9 such balls; fastest ball at 2 s 0.34, 0.55, 0.39, 0.35 m/s against
-  // 0.56–0.82; final KE 0.0055–0.0075 J (spin 0.0006) against 0.074–0.10 (spin
-  // 0.065–0.091; 2500, 2496, 2495 balls); beyond 0.5 m 4, 1, 4, 3 against 0, 3, 2, 3:
-  // balls bent outward past a tip before they touch anything (README). Cost: T_i+T_f+T_r
-  // per frame 85.9 against 69.0 ms (1 s, 1 thread, 2 interleaved pairs; QuickStep 17 → 32
-  // ms). falling_magnet does not take it: there its heap, stickier, slid later (README).
+  // at a tip rolls to and fro on it without loss otherwise
   s.options.rolling_friction_bodies = kRollingCoefficient * r;
   s.camera.eye = Eigen::Vector3f(0.55f, -0.65f, 0.45f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.17f);
   s.default_seconds = 2.0;
-  // the sheet spans ±0.27 m over the trunk (the 8 tip magnets centre on it horizontally);
-  // acceptance (#12): no ball beyond 0.5 m of the trunk
+  // the sheet spans ±0.27 m over the trunk (the 8 tip magnets centre on it horizontally):
+  // beyond 0.5 m of the trunk a ball was thrown
   s.escape_radius = 0.5;  // (m)
   return s;
 }

@@ -347,13 +347,17 @@ ENERGY_SERIES = (("energy_kinetic", "kinetic K", "tab:blue"),
                  ("energy_magnetic_work", "magnetic work W_mag", "tab:red"),
                  ("energy_contact_work", "contact work W_c", "tab:green"),
                  ("energy_eddy_work", "eddy-current loss W_e", "tab:orange"),
-                 ("energy_magnetic", "magnetic energy U_mag − U_mag(first)", "tab:purple"))
+                 ("energy_magnetic", "co-energy U* − U*(first)", "tab:purple"),
+                 ("energy_total", "E = K + U_g + U*, − E(first)", "black"),
+                 ("energy_created", "created: Σ max(0, ΔE)", "tab:pink"),
+                 ("energy_dissipated", "dissipated: Σ max(0, −ΔE)", "tab:gray"))
 
 
 def energy(summary_path, png_path):
     """The energy audit of one run (magsim-scene's summary.json, engine/energy.hpp): K, U_g,
-    the cumulative magnetic and contact work (and the eddy-current loss's, where a run has one)
-    and U_mag over time (offsets removed so that every curve starts at 0 except K), and below,
+    the cumulative magnetic and contact work (and the eddy-current loss's, where a run has one),
+    the co-energy U*, the total E = K + U_g + U* and what the steps created and dissipated of it
+    over time (offsets removed so that every curve starts at 0 except K), and below,
     the power of the magnetic forces and of the contacts between frames (J/s): where the
     energy of scattered bodies comes from."""
     with open(summary_path) as f:
@@ -366,13 +370,13 @@ def energy(summary_path, png_path):
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True,
                                   gridspec_kw={"height_ratios": [3, 2]})
     for key, label, color in ENERGY_SERIES:
-        if key == "energy_eddy_work" and not any(ser.get(key, [])):
-            continue  # no eddy loss in this run (or a summary from before it existed)
+        if key not in ser or (key == "energy_eddy_work" and not any(ser.get(key, []))):
+            continue  # no eddy loss in this run (or a summary from before the series existed)
         tt, y = t, ser[key]
-        if key == "energy_magnetic":
-            # U_mag is known from the first step on (the frame at t = 0 holds 0)
+        if key in ("energy_magnetic", "energy_total"):
+            # U* is known from the first step on (the frame at t = 0 holds 0)
             tt, y = t[1:], y[1:]
-        if key in ("energy_gravitational", "energy_magnetic") and y:
+        if key in ("energy_gravitational", "energy_magnetic", "energy_total") and y:
             y = [v - y[0] for v in y]
         ax.plot(tt, y, label=label, color=color)
     ax.axhline(0, color="black", linewidth=0.5)
@@ -380,10 +384,11 @@ def energy(summary_path, png_path):
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     e = s.get("energy", {})
-    ax.set_title(f"{s.get('scene')} {s.get('method')}: energy audit "
+    ax.set_title(f"{s.get('scene')} {s.get('method')} ({s.get('force_model', '?')} force): energy audit "
                  f"(final W_mag {e.get('magnetic_work', float('nan')):.3g} J, "
-                 f"W_c {e.get('contact_work', float('nan')):.3g} J, K {e.get('kinetic', float('nan')):.3g} J)",
-                 fontsize=10)
+                 f"W_c {e.get('contact_work', float('nan')):.3g} J, K {e.get('kinetic', float('nan')):.3g} J; "
+                 f"created {e.get('created', float('nan')):.3g} J, dissipated {e.get('dissipated', float('nan')):.3g} J)",
+                 fontsize=9)
     for key, label, color in (("energy_magnetic_work", "magnetic", "tab:red"),
                               ("energy_contact_work", "contacts", "tab:green"),
                               ("energy_eddy_work", "eddy-current loss", "tab:orange")):
