@@ -61,14 +61,12 @@
 #include "scenes/json_reader.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/json_unique_keys.hpp"
+#include "scenes/text_file.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <initializer_list>
-#include <sstream>
 #include <stdexcept>
 
 namespace magsim::scenes {
@@ -256,7 +254,7 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   json doc;
   try {
     doc = parse_unique_keys(text, /*ignore_comments=*/true);
-  } catch (const DuplicateKeyError& e) {  // "bodies[0].position: duplicate key"
+  } catch (const JsonStructureError& e) {  // "bodies[0].position: duplicate key", too deep, a NUL
     r.fail("", e.what());
   } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
     std::string what = e.what();
@@ -288,15 +286,13 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
 }
 
 SceneDesc load_scene_file(const std::string& path) {
-  // a directory opens as an ifstream and reads as empty ("malformed JSON" would mislead)
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory, not a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open the scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw std::runtime_error(path + ": cannot read the scene file");
-  return parse_scene_json(text.str(), path);
+  std::string text;
+  try {
+    text = read_text_file(path);  // regular files only, at most kMaxInputBytes
+  } catch (const InputFileError& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  return parse_scene_json(text, path);
 }
 
 // ---- writing (the inverse of the reader above: every field, so a scene reloads as it was) ----

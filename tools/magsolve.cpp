@@ -10,6 +10,7 @@
 #include "scenes/json_reader.hpp"
 #include "scenes/json_unique_keys.hpp"
 #include "scenes/options_json.hpp"
+#include "scenes/text_file.hpp"
 #include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
@@ -21,10 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 #include <numeric>
 #include <stdexcept>
 
@@ -132,23 +130,6 @@ void check_separations(const mag::MomentSet& set) {
 
 json vec_json(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-// The whole file as text. A directory opens as an ifstream on Linux and throws
-// std::ios_failure on the first read, so it is refused by name first.
-std::string read_text(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError("is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot read file");
-  std::ostringstream text;
-  try {
-    text << in.rdbuf();
-  } catch (const std::exception& e) {
-    throw InputError(std::string("cannot read file (") + e.what() + ")");
-  }
-  if (in.bad()) throw InputError("cannot read file");
-  return text.str();
-}
-
 // The Newton reference holds the dense 3N x 3N interaction matrix T, the Jacobian and its
 // LU factors (N induced moments): three matrices of doubles. Above this bound magsolve
 // refuses up front instead of dying in bad_alloc or paging for hours.
@@ -193,7 +174,8 @@ int run(int argc, char** argv) {
   app.footer(magsim::tools::exit_codes_footer(
       "bad input or flags", "the solve failed", "the output could not be written",
       "The Newton reference needs three dense 3N x 3N matrices for N induced moments; above 2 GiB "
-      "(N > 3153) magsolve refuses the case (exit 1)."));
+      "(N > 3153) magsolve refuses the case (exit 1). So it does a CASE that is not a regular file "
+      "or is larger than 1 GiB."));
   if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
 
   if (!std::isfinite(residual_tol)) {
@@ -208,11 +190,16 @@ int run(int argc, char** argv) {
   }
   mag::MomentSet set;
   try {
-    const std::string text = read_text(path);
+    std::string text;
+    try {
+      text = magsim::scenes::read_text_file(path);  // regular files only, at most 1 GiB
+    } catch (const magsim::scenes::InputFileError& e) {
+      throw InputError(e.what());
+    }
     json doc;
     try {
       doc = magsim::scenes::parse_unique_keys(text);
-    } catch (const magsim::scenes::DuplicateKeyError& e) {
+    } catch (const magsim::scenes::JsonStructureError& e) {  // a duplicate key, too deep, a NUL
       throw InputError(e.what());
     } catch (const json::exception& e) {  // syntax errors and numbers out of range
       throw InputError(std::string("malformed JSON: ") + e.what());

@@ -6,10 +6,23 @@
 
 #include <catch2/catch.hpp>
 
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace {
 
@@ -27,6 +40,16 @@ std::size_t lines(const std::string& s) {
   std::size_t n = 0;
   for (char c : s) n += c == '\n';
   return n;
+}
+
+std::string text_of(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
 }
 
 }  // namespace
@@ -374,4 +397,78 @@ TEST_CASE("magsolve: a long Newton reference reports its progress on stderr", "[
   // small cases stay quiet
   const CommandResult small = solve(example("touching_spheres.json"));
   CHECK(small.out.find("Newton reference") == std::string::npos);
+}
+
+// ---- the third round: never damage, never hang, never die on a signal ----------------------
+
+TEST_CASE("a scene file or magsolve case that is a FIFO or a device is refused at once, exit 1", "[reliability]") {
+  const std::string fifo = tmp("fifo.json"), zero = tmp("zero.json");
+  REQUIRE(::mkfifo(fifo.c_str(), 0644) == 0);
+  REQUIRE(::symlink("/dev/zero", zero.c_str()) == 0);
+  struct Case {
+    std::string path;
+    const char* says;
+  };
+  for (const Case& c : {Case{fifo, "is a FIFO, not a regular file"}, Case{zero, "is a character device, not a regular file"},
+                        Case{"/dev/zero", "is a character device, not a regular file"}}) {
+    for (const bool solver : {true, false}) {
+      if (!solver && c.path == "/dev/zero") continue;  // magsim-scene reads FILE.json only
+      // before: a FIFO blocked for ever, /dev/zero was read until memory ran out
+      const std::string bin = std::string("ulimit -v 1500000; timeout 20 ") + (solver ? MAGSOLVE_BIN : MAGSIM_SCENE_BIN);
+      const CommandResult r = magsim::test::run_command(
+          bin, c.path + (solver ? "" : " --steps 1 --no-render --out " + tmp("nonregular_out")));
+      INFO((solver ? "magsolve " : "magsim-scene ") << c.path << ": exit " << r.code << ": " << r.out);
+      CHECK(r.code == 1);
+      CHECK(r.out.find(c.says) != std::string::npos);
+      CHECK(lines(r.out) == 1);
+    }
+  }
+  CHECK(scene("--help").out.find("larger than 1 GiB") != std::string::npos);
+  CHECK(solve("--help").out.find("larger than 1 GiB") != std::string::npos);
+}
+
+TEST_CASE("JSON nested deeper than 64 levels is refused in both tools, fast and in little memory", "[reliability]") {
+  auto nested = [](int levels) { return std::string(levels, '[') + std::string(levels, ']'); };
+  const std::string ok = tmp("depth64.json"), deep = tmp("depth65.json"), deep_case = tmp("depth65_case.json");
+  write_text(ok, "{\"bodies\": [], \"comment\": " + nested(63) + "}");  // 64 levels with the outer object
+  write_text(deep, "{\"bodies\": [], \"comment\": " + nested(64) + "}");
+  write_text(deep_case, "{\"moments\": " + nested(64) + "}");
+  CHECK(scene(ok + " --steps 1 --no-render --out " + tmp("depth_out")).code == 0);
+  const CommandResult s = scene(deep + " --steps 1 --no-render --out " + tmp("depth_out"));
+  INFO(s.out);
+  CHECK(s.code == 1);
+  CHECK(s.out.find("nested deeper than 64 levels") != std::string::npos);
+  CHECK(lines(s.out) == 1);
+  const CommandResult m = solve(deep_case);
+  INFO(m.out);
+  CHECK(m.code == 1);
+  CHECK(m.out.find("nested deeper than 64 levels") != std::string::npos);
+  // 100,000 levels (200 KB) with 1.5 GB of address space: the path kept at every level needed
+  // gigabytes before (bad_alloc, exit 2)
+  const std::string huge = tmp("depth_huge.json");
+  write_text(huge, nested(100000));
+  for (const bool solver : {true, false}) {
+    const CommandResult r = magsim::test::run_command(
+        std::string("ulimit -v 1500000; timeout 60 ") + (solver ? MAGSOLVE_BIN : MAGSIM_SCENE_BIN),
+        huge + (solver ? "" : " --steps 1 --no-render --out " + tmp("depth_huge_out")));
+    INFO((solver ? "magsolve: " : "magsim-scene: ") << r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find("nested deeper than 64 levels") != std::string::npos);
+  }
+}
+
+TEST_CASE("a valid document followed by a NUL byte and junk is refused in both tools", "[reliability]") {
+  // nlohmann's lexer takes a NUL for the end of the text: the junk was never read
+  const std::string nul_scene = tmp("nul_junk.json"), nul_case = tmp("nul_junk_case.json");
+  write_text(nul_scene, std::string("{\"bodies\": []}\0junk", 19));
+  write_text(nul_case, text_of(example("touching_spheres.json")) + std::string("\0{junk", 6));
+  const CommandResult s = scene(nul_scene + " --steps 1 --no-render --out " + tmp("nul_out"));
+  INFO(s.out);
+  CHECK(s.code == 1);
+  CHECK(s.out.find("malformed JSON: a NUL byte at byte offset 14") != std::string::npos);
+  CHECK(lines(s.out) == 1);
+  const CommandResult m = solve(nul_case);
+  INFO(m.out);
+  CHECK(m.code == 1);
+  CHECK(m.out.find("a NUL byte") != std::string::npos);
 }

@@ -227,7 +227,8 @@ int main(int argc, char** argv) {
 
   app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
                                       "an output file could not be written",
-                                      "Runs longer than 1e7 rigid steps are refused."));
+                                      "Runs longer than 1e7 rigid steps are refused; so are scene files that are not regular "
+                                      "files or are larger than 1 GiB."));
   if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
   if (a.list) {
     for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
