@@ -36,6 +36,7 @@ using magsim::tools::kBadInput;
 using magsim::tools::kIoError;
 using magsim::tools::kOk;
 using magsim::tools::kRunFailed;
+using magsim::tools::one_line;
 
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -160,7 +161,7 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration")
       ->capture_default_str();
-  app.add_option("--max-iter", max_iter, "iteration cap")->capture_default_str();
+  app.add_option("--max-iter", max_iter, "iteration cap")->check(magsim::tools::Decimal)->capture_default_str();
   app.add_option("--softening", softening,
                  "softening length ε in metres (0 = off; needed for two moments closer than half "
                  "the sum of their radii, a = the radius of a sphere of the moment's volume)")
@@ -168,15 +169,19 @@ int run(int argc, char** argv) {
   app.add_option("--residual-tol", residual_tol,
                  "\"converged\" needs the iteration to stop (--tol) and every induced moment's "
                  "|M - f(H)| <= this x max(|M|, |f(H)|)")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(magsim::tools::PositiveNumber)->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
   app.footer(magsim::tools::exit_codes_footer(
       "bad input or flags", "the solve failed", "the output could not be written",
       "The Newton reference needs three dense 3N x 3N matrices for N induced moments; above 2 GiB "
       "(N > 3153) magsolve refuses the case (exit 1). So it does a CASE that is not a regular file "
-      "or is larger than 1 GiB."));
-  if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
+      "or is larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores."));
+  if (const int code = magsim::tools::parse_command_line(app, argc, argv, "magsolve: "); code >= 0) return code;
+  if (const std::string e = magsim::tools::omp_num_threads_error(); !e.empty()) {
+    std::fprintf(stderr, "magsolve: %s\n", e.c_str());
+    return kBadInput;
+  }
 
   if (!std::isfinite(residual_tol)) {
     std::fprintf(stderr, "magsolve: --residual-tol: must be a finite number > 0\n");
@@ -231,10 +236,10 @@ int run(int argc, char** argv) {
     }
     if (opt.field.softening == 0.0) check_separations(set);
   } catch (const InputError& e) {
-    std::fprintf(stderr, "magsolve: %s: %s\n", path.c_str(), e.what());
+    std::fprintf(stderr, "magsolve: %s: %s\n", one_line(path).c_str(), one_line(e.what()).c_str());
     return kBadInput;
   } catch (const std::runtime_error& e) {  // JsonReader: "<file>: <json path>: <what>"
-    std::fprintf(stderr, "magsolve: %s\n", e.what());
+    std::fprintf(stderr, "magsolve: %s\n", one_line(e.what()).c_str());
     return kBadInput;
   }
 
@@ -321,6 +326,7 @@ int run(int argc, char** argv) {
                          "f(H): relative residual %.3g at moments[%zu] > --residual-tol %g; "
                          "\"converged\": false\n", residual, worst, residual_tol);
 
+  errno = 0;  // the cause of a failed write below
   if (format == "json") {
     json out;
     out["method"] = mag::method_name(opt.method);
@@ -359,25 +365,19 @@ int run(int argc, char** argv) {
                   Fc[j].y(), Fc[j].z());
     }
   }
-  // a full disk or a closed pipe must not pass as success: flush and check both streams
-  std::cout.flush();
-  const bool written = std::cout.good() && std::fflush(stdout) == 0 && !std::ferror(stdout);
-  if (!written) {
-    std::fprintf(stderr, "magsolve: writing the results to stdout failed (%s)\n",
-                 errno ? std::strerror(errno) : "stream error");
-    return kIoError;
-  }
-  return kOk;
+  // a full disk or a closed pipe (EPIPE: SIGPIPE is ignored) must not pass as success
+  return magsim::tools::stdout_written("magsolve: ", "the results") ? kOk : kIoError;
 }
 
 }  // namespace
 
 // Anything not caught above (e.g. std::bad_alloc) ends in one line and exit 2, not abort().
 int main(int argc, char** argv) {
+  magsim::tools::ignore_write_signals();
   try {
     return run(argc, argv);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "magsolve: error: %s\n", e.what());
+    std::fprintf(stderr, "magsolve: error: %s\n", one_line(e.what()).c_str());
     return kRunFailed;
   }
 }

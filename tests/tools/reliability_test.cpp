@@ -52,6 +52,87 @@ void write_text(const std::string& path, const std::string& text) {
   f << text;
 }
 
+// the kind of file at path, not following a symlink (S_IFREG, S_IFIFO, S_IFLNK, …; 0: none)
+mode_t kind_at(const std::string& path) {
+  struct stat st {};
+  return ::lstat(path.c_str(), &st) == 0 ? (st.st_mode & S_IFMT) : 0;
+}
+
+// How a child process ended: its exit code, or the signal that killed it.
+struct Ended {
+  bool signaled = false;
+  int code = -1;
+};
+
+// `sh -c cmd` as a child with default signal dispositions and an empty signal mask (as from
+// an interactive shell; the test runner's own must not leak into the program), stdout on
+// out_fd when >= 0. cmd should `exec` the program, so the pid is the program's.
+pid_t spawn(const std::string& cmd, int out_fd = -1) {
+  const pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGXFSZ}) std::signal(sig, SIG_DFL);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    if (out_fd >= 0) ::dup2(out_fd, 1);
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Waits for pid, at most `limit` (then kills it: a test never hangs).
+Ended wait_for(pid_t pid, std::chrono::seconds limit = std::chrono::seconds(120)) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  int st = 0;
+  for (;;) {
+    const pid_t r = ::waitpid(pid, &st, WNOHANG);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) return {};
+    if (std::chrono::steady_clock::now() > end) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &st, 0);
+      FAIL_CHECK("the program did not end within " << limit.count() << " s; killed");
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  Ended e;
+  e.signaled = WIFSIGNALED(st);
+  e.code = e.signaled ? WTERMSIG(st) : WEXITSTATUS(st);
+  return e;
+}
+
+// `sh -c cmd` with its stdout on a pipe whose reader is gone (as `| head -1` after its line)
+Ended run_into_closed_pipe(const std::string& cmd) {
+  int fds[2];
+  REQUIRE(::pipe(fds) == 0);
+  ::close(fds[0]);
+  const pid_t pid = spawn(cmd, fds[1]);
+  ::close(fds[1]);
+  return wait_for(pid);
+}
+
+// every line of the CSV has `fields` fields and the file ends with a line break
+void check_whole_rows(const std::string& path, std::size_t fields) {
+  const std::string csv = text_of(path);
+  REQUIRE(!csv.empty());
+  CHECK(csv.back() == '\n');
+  std::size_t start = 0, bad = 0, rows = 0;
+  while (start < csv.size()) {
+    std::size_t end = csv.find('\n', start);
+    if (end == std::string::npos) end = csv.size();
+    std::size_t commas = 0;
+    for (std::size_t i = start; i < end; ++i) commas += csv[i] == ',';
+    bad += commas + 1 != fields;
+    ++rows;
+    start = end + 1;
+  }
+  INFO(path << ": " << rows << " rows");
+  CHECK(bad == 0);
+}
+
 }  // namespace
 
 TEST_CASE("magsolve: a directory as the case file is a one-line error, exit 1", "[reliability]") {
@@ -471,4 +552,116 @@ TEST_CASE("a valid document followed by a NUL byte and junk is refused in both t
   INFO(m.out);
   CHECK(m.code == 1);
   CHECK(m.out.find("a NUL byte") != std::string::npos);
+}
+
+TEST_CASE("OMP_NUM_THREADS: above 4x the cores or not a thread count is refused in one line, exit 1", "[reliability]") {
+  for (const char* value : {"100000", "0", "abc", "-1", "", "4,"}) {
+    for (const bool solver : {true, false}) {
+      const std::string env = std::string("OMP_NUM_THREADS='") + value + "' ";
+      const CommandResult r = solver ? magsim::test::run_command(env + MAGSOLVE_BIN, example("touching_spheres.json"))
+                                     : magsim::test::run_command(env + MAGSIM_SCENE_BIN,
+                                                                 "balls_up --count 5 --steps 1 --no-render --out " +
+                                                                     tmp("omp"));
+      INFO((solver ? "magsolve" : "magsim-scene") << " OMP_NUM_THREADS='" << value << "': exit " << r.code << ": " << r.out);
+      CHECK(r.code == 1);
+      CHECK(r.out.find("OMP_NUM_THREADS") != std::string::npos);
+      CHECK(r.out.find(std::string(value).size() > 3 ? "more than the" : "must be a thread count in [1, ") != std::string::npos);
+    }
+  }
+  // a count within the cap runs
+  CHECK(magsim::test::run_command("OMP_NUM_THREADS=1 " + std::string(MAGSOLVE_BIN), example("touching_spheres.json")).code == 0);
+}
+
+TEST_CASE("a closed pipe: magsolve's results are an I/O error (exit 3), a scene run is not killed", "[reliability]") {
+  const std::string err = tmp("pipe_err.txt");
+  const Ended m = run_into_closed_pipe(std::string("exec ") + MAGSOLVE_BIN + " " + example("touching_spheres.json") + " 2>" + err);
+  INFO("magsolve: " << (m.signaled ? "killed by signal " : "exit ") << m.code << ": " << text_of(err));
+  CHECK(!m.signaled);
+  CHECK(m.code == 3);
+  CHECK(text_of(err).find("writing the results to stdout failed (Broken pipe)") != std::string::npos);
+  CHECK(lines(text_of(err)) == 1);
+  // magsim-scene's lines (progress, the closing line) go to stderr, here the closed pipe:
+  // lost, and the run completes
+  const std::string out = tmp("pipe_scene");
+  const Ended s = run_into_closed_pipe(std::string("exec ") + MAGSIM_SCENE_BIN + " balls_up --count 5 --steps 20 --no-render --out " +
+                                       out + " 2>&1");
+  INFO("magsim-scene: " << (s.signaled ? "killed by signal " : "exit ") << s.code);
+  CHECK(!s.signaled);
+  CHECK(s.code == 0);
+  const auto summary = nlohmann::json::parse(text_of(out + "/summary.json"));
+  CHECK(summary["steps"] == 20);
+  check_whole_rows(out + "/states.csv", 11);
+}
+
+TEST_CASE("magsim-scene: a file size limit (SIGXFSZ) is an I/O error, exit 3", "[reliability]") {
+  const std::string out = tmp("fsize");
+  // 100 blocks of 512 bytes (dash): states.csv passes it within the first frames
+  const CommandResult r = magsim::test::run_command(std::string("ulimit -f 100; ") + MAGSIM_SCENE_BIN,
+                                                    "balls_up --steps 50 --fps 1000 --no-render --threads 1 --out " + out);
+  INFO(r.out);
+  CHECK(r.code == 3);
+  CHECK(r.out.find("(File too large)") != std::string::npos);
+  CHECK(nlohmann::json::parse(text_of(out + "/summary.json"))["error"].get<std::string>().find("File too large") !=
+        std::string::npos);
+}
+
+TEST_CASE("flags: an empty --write-scene or --out and non-decimal integers are refused, exit 1", "[reliability]") {
+  const std::string out = tmp("empty_write_scene");
+  const CommandResult w = scene("balls_up --count 3 --steps 1 --no-render --out " + out + " --write-scene ''");
+  INFO(w.out);
+  CHECK(w.code == 1);
+  CHECK(w.out.find("--write-scene: needs a non-empty path") != std::string::npos);
+  CHECK(kind_at(out) == 0);  // no run instead
+  const CommandResult o = scene("balls_up --count 3 --steps 1 --no-render --out ''");
+  INFO(o.out);
+  CHECK(o.code == 1);
+  CHECK(o.out.find("--out: needs a non-empty path") != std::string::npos);
+  // CLI11 read 0x10 as 16 and 010 as 8
+  for (const char* flags : {"--steps 0x10", "--steps 010", "--steps 1e1", "--width 0x100", "--count 0x5", "--threads 01",
+                            "--bh-threshold 0x10"}) {
+    const CommandResult f = scene(std::string("balls_up --count 3 --no-render --out ") + tmp("hex") + " " + flags);
+    INFO(flags << ": " << f.out);
+    CHECK(f.code == 1);
+    CHECK(f.out.find("must be a whole decimal number") != std::string::npos);
+  }
+  for (const char* flags : {"--max-iter 0x10", "--max-iter 010"}) {
+    const CommandResult f = solve(example("touching_spheres.json") + " " + flags);
+    INFO(flags << ": " << f.out);
+    CHECK(f.code == 1);
+    CHECK(f.out.find("--max-iter: must be a whole decimal number") != std::string::npos);
+  }
+}
+
+TEST_CASE("both tools: --help into a full disk is exit 3", "[reliability]") {
+  for (const char* bin : {MAGSIM_SCENE_BIN, MAGSOLVE_BIN}) {
+    const CommandResult r = magsim::test::run_command(std::string("{ ") + bin, "--help 2>&1 > /dev/full; }");
+    INFO(bin << ": " << r.out);
+    CHECK(r.code == 3);
+    CHECK(r.out.find("writing the help to stdout failed (No space left on device)") != std::string::npos);
+  }
+}
+
+TEST_CASE("flags: errors are one line, ranges in %g", "[reliability]") {
+  struct Case {
+    const char* flags;
+    const char* says;
+  };
+  for (const Case& c : {Case{"--strength -1", "--strength: must be a number > 0, got -1"},
+                        Case{"--dt-m -1", "--dt-m: must be a number > 0, got -1"},
+                        Case{"--rolling-friction -1", "--rolling-friction: must be a number >= 0, got -1"},
+                        Case{"--dt 1", "--dt: must be a number in [1e-07, 0.1], got 1"},
+                        Case{"--fps 0", "--fps: must be a number in [0.001, 1e+09], got 0"},
+                        Case{"--bogus", "--bogus"}, Case{"--steps 0", "--steps: must be in [1, 10000000], got 0"}}) {
+    const CommandResult r = scene(std::string("balls_up --count 3 --no-render --out ") + tmp("wording") + " " + c.flags);
+    INFO(c.flags << ": " << r.out);
+    CHECK(r.code == 1);
+    CHECK(r.out.find(c.says) != std::string::npos);
+    CHECK(lines(r.out) == 1);
+    CHECK(r.out.size() < 200);  // DBL_MAX printed as 309 digits before
+  }
+  const CommandResult m = solve(example("touching_spheres.json") + " --residual-tol -1");
+  INFO(m.out);
+  CHECK(m.code == 1);
+  CHECK(m.out.find("--residual-tol: must be a number > 0, got -1") != std::string::npos);
+  CHECK(lines(m.out) == 1);
 }
