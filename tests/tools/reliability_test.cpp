@@ -665,3 +665,79 @@ TEST_CASE("flags: errors are one line, ranges in %g", "[reliability]") {
   CHECK(m.out.find("--residual-tol: must be a number > 0, got -1") != std::string::npos);
   CHECK(lines(m.out) == 1);
 }
+
+TEST_CASE("magsim-scene --write-scene: only a regular file is replaced, through a unique temporary file", "[reliability]") {
+  static int pass = 0;  // each SECTION runs the test case anew: a folder of its own
+  const std::string dir = tmp("write_scene_targets_" + std::to_string(pass++));
+  REQUIRE(std::system(("mkdir -p " + dir).c_str()) == 0);
+  auto write = [&](const std::string& name) { return scene("balls_up --count 3 --write-scene " + dir + "/" + name); };
+  SECTION("a FIFO, a directory or a device node is refused and left as it is") {
+    REQUIRE(::mkfifo((dir + "/fifo.json").c_str(), 0644) == 0);
+    REQUIRE(::mkdir((dir + "/dir.json").c_str(), 0755) == 0);
+    for (const char* name : {"fifo.json", "dir.json"}) {
+      const mode_t before = kind_at(dir + "/" + name);
+      const CommandResult r = write(name);
+      INFO(name << ": " << r.out);
+      CHECK(r.code == 1);
+      CHECK(r.out.find("not a regular file; it is not replaced") != std::string::npos);
+      CHECK(lines(r.out) == 1);
+      CHECK(kind_at(dir + "/" + name) == before);
+    }
+    // a character device (root only: mknod); the program is aimed at a copy of /dev/null's node
+    if (::mknod((dir + "/null.json").c_str(), S_IFCHR | 0666, makedev(1, 3)) == 0) {
+      const CommandResult r = write("null.json");
+      INFO(r.out);
+      CHECK(r.code == 1);
+      CHECK(r.out.find("is a character device") != std::string::npos);
+      CHECK(kind_at(dir + "/null.json") == S_IFCHR);
+    } else {
+      WARN("cannot mknod here (not root?): the device-node case is skipped");
+    }
+  }
+  SECTION("a symlink is written through to its regular target; one to a FIFO or nowhere is refused") {
+    write_text(dir + "/target.json", "old");
+    REQUIRE(::chmod((dir + "/target.json").c_str(), 0640) == 0);
+    REQUIRE(::symlink("target.json", (dir + "/link.json").c_str()) == 0);
+    const CommandResult r = write("link.json");
+    INFO(r.out);
+    CHECK(r.code == 0);
+    CHECK(kind_at(dir + "/link.json") == S_IFLNK);
+    CHECK(text_of(dir + "/target.json").find("\"bodies\"") != std::string::npos);
+    struct stat st {};
+    REQUIRE(::stat((dir + "/target.json").c_str(), &st) == 0);
+    CHECK((st.st_mode & 0777) == 0640);  // the file's permissions are kept
+    REQUIRE(::mkfifo((dir + "/fifo2").c_str(), 0644) == 0);
+    REQUIRE(::symlink("fifo2", (dir + "/to_fifo.json").c_str()) == 0);
+    REQUIRE(::symlink("nowhere.json", (dir + "/dangling.json").c_str()) == 0);
+    for (const char* name : {"to_fifo.json", "dangling.json"}) {
+      const CommandResult b = write(name);
+      INFO(name << ": " << b.out);
+      CHECK(b.code == 1);
+      CHECK(lines(b.out) == 1);
+      CHECK(kind_at(dir + "/" + name) == S_IFLNK);
+    }
+    CHECK(kind_at(dir + "/fifo2") == S_IFIFO);
+    CHECK(kind_at(dir + "/nowhere.json") == 0);
+  }
+  SECTION("the user's own x.json.tmp is not touched, and no temporary file is left") {
+    write_text(dir + "/x.json.tmp", "mine");
+    const CommandResult r = write("x.json");
+    INFO(r.out);
+    CHECK(r.code == 0);
+    CHECK(text_of(dir + "/x.json.tmp") == "mine");
+    CHECK(text_of(dir + "/x.json").find("\"bodies\"") != std::string::npos);
+    const CommandResult ls = magsim::test::run_command("ls -A", dir);
+    CHECK(ls.out == "x.json\nx.json.tmp\n");
+  }
+}
+
+TEST_CASE("magsim-scene: an output name in --out that is a FIFO is refused, not deleted", "[reliability]") {
+  const std::string dir = tmp("out_fifo");
+  REQUIRE(std::system(("mkdir -p " + dir).c_str()) == 0);
+  REQUIRE(::mkfifo((dir + "/states.csv").c_str(), 0644) == 0);
+  const CommandResult r = scene("balls_up --count 3 --steps 1 --no-render --out " + dir);
+  INFO(r.out);
+  CHECK(r.code == 3);
+  CHECK(r.out.find("states.csv is not a regular file") != std::string::npos);
+  CHECK(kind_at(dir + "/states.csv") == S_IFIFO);
+}

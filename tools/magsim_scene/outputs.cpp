@@ -9,6 +9,8 @@ namespace magsim::scene_tool {
 bool is_output_name(const std::string& f) {
   for (const char* n : kOutputNames)
     if (f == n) return true;
+  // summary.json's temporary file (tools/replace_file.hpp), left by a killed run
+  if (f.size() == 20 && f.compare(0, 14, ".summary.json.") == 0) return true;
   // frame_%06d.png (six or more digits)
   const std::size_t digits = f.size() >= 10 ? f.size() - 10 : 0;
   if (f.size() < 16 || f.compare(0, 6, "frame_") != 0 || f.compare(f.size() - 4, 4, ".png") != 0) return false;
@@ -39,6 +41,8 @@ void prepare_out_dir(const std::string& dir) {
   fs::remove(probe, ec);
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     if (!is_output_name(e.path().filename().string()) || e.is_directory(ec)) continue;
+    if (!e.is_symlink(ec) && !e.is_regular_file(ec))  // a FIFO or device is not an old output
+      throw IoError("--out " + dir + ": " + e.path().filename().string() + " is not a regular file; it is not replaced");
     if (!fs::remove(e.path(), ec) && ec)
       throw IoError("--out " + dir + ": cannot delete the old " + e.path().filename().string() + " (" + ec.message() + ")");
   }

@@ -35,7 +35,8 @@ bool is_output_name(const std::string& f);
 // fields are written as they are (so ordinary output does not change)
 std::string csv_field(const std::string& v);
 // Creates DIR (and parents), checks that files can be written into it and deletes the
-// outputs of an earlier run there (only this program's own names, see is_output_name).
+// outputs of an earlier run there (only this program's own names, see is_output_name; one
+// that is not a regular file or a symlink is refused, not deleted).
 void prepare_out_dir(const std::string& dir);
 // summary.json "energy" (outputs.cpp)
 json energy_json(const engine::Simulation& sim);

@@ -14,6 +14,7 @@
 #include "scenes/options_json.hpp"
 #include "scenes/scene_file.hpp"
 #include "tools/magsim_scene/outputs.hpp"
+#include "tools/replace_file.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -21,7 +22,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -241,22 +241,15 @@ int run(const Args& a, const CLI::App& app) {
       {"state_hash", hash},
       {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};
 
-  // written to a temporary name and renamed when complete: a full disk leaves no
-  // summary.json that looks valid
+  // written to a unique temporary name and renamed when complete (tools/replace_file.hpp): a
+  // full disk leaves no summary.json that looks valid
   const fs::path path = fs::path(dir) / "summary.json";
-  const fs::path tmp = fs::path(dir) / "summary.json.tmp";
-  {
-    std::ofstream out(tmp);
-    out << summary.dump(1) << '\n';
-    out.close();
-    std::error_code ec;
-    if (!out || (fs::rename(tmp, path, ec), ec)) {
-      const std::string why = ec ? ec.message() : errno_text();
-      fs::remove(tmp, ec);
-      std::fprintf(stderr, "error: cannot write %s (%s)%s%s\n", path.c_str(), why.c_str(),
-                   io_error.empty() ? "" : "; before that: ", io_error.c_str());
-      return kIoError;
-    }
+  try {
+    tools::replace_file(path.string(), summary.dump(1) + "\n");
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "error: cannot write %s: %s%s%s\n", path.c_str(), tools::one_line(e.what()).c_str(),
+                 io_error.empty() ? "" : "; before that: ", tools::one_line(io_error).c_str());
+    return kIoError;
   }
   if (!io_error.empty()) {
     std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", io_error.c_str(), path.c_str());
@@ -277,22 +270,19 @@ int run(const Args& a, const CLI::App& app) {
 }
 
 
-// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written to
-// FILE.tmp and renamed, so a failed write leaves no half file under the name.
+// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written whole
+// through a temporary file (tools/replace_file.hpp): a regular file or a symlink to one is
+// replaced, a missing one created; a directory, device, FIFO or dangling link is refused.
 int write_scene(const Args& a, const CLI::App& app) {
   const engine::SceneDesc scene = resolve_scene(a, app);
-  const fs::path path = a.write_scene;
-  const fs::path tmp = path.string() + ".tmp";
-  std::ofstream out(tmp);
-  out << scenes::scene_to_json(scene).dump(1) << '\n';
-  out.close();
-  std::error_code ec;
-  if (!out || (fs::rename(tmp, path, ec), ec)) {
-    const std::string why = ec ? ec.message() : errno_text();
-    fs::remove(tmp, ec);
-    throw IoError("--write-scene: cannot write " + path.string() + " (" + why + ")");
+  try {
+    tools::replace_file(a.write_scene, scenes::scene_to_json(scene).dump(1) + "\n");
+  } catch (const tools::NotARegularFile& e) {
+    throw UsageError("--write-scene " + a.write_scene + ": " + e.what());
+  } catch (const tools::WriteFailed& e) {
+    throw IoError("--write-scene: cannot write " + a.write_scene + ": " + e.what());
   }
-  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), path.c_str());
+  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), a.write_scene.c_str());
   return kOk;
 }
 
