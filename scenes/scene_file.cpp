@@ -66,6 +66,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <stdexcept>
 
@@ -168,12 +169,44 @@ MomentDesc read_moment(const JsonReader& r, const json& j, const std::string& pa
   return m;
 }
 
+// `s` for an error line: control bytes as \n, \t, \xNN; cut after about 60 bytes (at a
+// UTF-8 character boundary)
+std::string escaped(const std::string& s) {
+  std::string e;
+  std::size_t i = 0;
+  for (; i < s.size() && (e.size() < 60 || (static_cast<unsigned char>(s[i]) & 0xc0) == 0x80); ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    char hex[5];
+    std::snprintf(hex, sizeof hex, "\\x%02x", c);
+    if (c == '\n') e += "\\n";
+    else if (c == '\r') e += "\\r";
+    else if (c == '\t') e += "\\t";
+    else if (c < 0x20 || c == 0x7f) e += hex;
+    else e += s[i];
+  }
+  return i < s.size() ? e + "..." : e;
+}
+
+// A body name is written into states.csv (quoted when it holds a comma, quote or line break)
+// and error lines: tab and line breaks are allowed, other control bytes (NUL cut the name in
+// states.csv) are refused.
+void check_body_name(const JsonReader& r, const std::string& name, const std::string& path) {
+  for (const char ch : name) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f)
+      r.fail(path, "must not contain control characters other than tab and line breaks (got \"" + escaped(name) + "\")");
+  }
+}
+
 BodyDesc read_body(const JsonReader& r, const json& j, const std::string& path, std::size_t i) {
   r.keys(j, path, {"name", "type", "position", "orientation", "velocity", "angular_velocity",
                    "density", "mass", "shapes", "moments", "color", "visible", "magnet"});
   BodyDesc b;
   b.name = "body_" + std::to_string(i);
-  if_present(j, "name", path, [&](const json& v, const std::string& p) { b.name = r.string(v, p); });
+  if_present(j, "name", path, [&](const json& v, const std::string& p) {
+    b.name = r.string(v, p);
+    check_body_name(r, b.name, p);
+  });
   if_present(j, "type", path, [&](const json& v, const std::string& p) { b.type = body_type(r, v, p); });
   if_present(j, "position", path, [&](const json& v, const std::string& p) { b.position = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   if_present(j, "orientation", path, [&](const json& v, const std::string& p) { b.orientation = r.quat(v, p); });

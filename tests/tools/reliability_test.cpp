@@ -741,3 +741,53 @@ TEST_CASE("magsim-scene: an output name in --out that is a FIFO is refused, not 
   CHECK(r.out.find("states.csv is not a regular file") != std::string::npos);
   CHECK(kind_at(dir + "/states.csv") == S_IFIFO);
 }
+
+TEST_CASE("scene files: control characters in a body name are refused, or escaped in error lines", "[reliability]") {
+  // NUL cut the name in states.csv; ESC reached the terminal
+  const std::string name = tmp("nul_name.json");
+  write_text(name, R"({"bodies": [{"name": "ok", "shapes": [{"size": 0.01}]},
+                                 {"name": "a\u0000b\u001b[31m", "shapes": [{"size": 0.01}]}]})");
+  const CommandResult n = scene(name + " --steps 1 --no-render --out " + tmp("nul_name_out"));
+  INFO(n.out);
+  CHECK(n.code == 1);
+  CHECK(n.out.find("bodies[1].name: must not contain control characters") != std::string::npos);
+  CHECK(n.out.find("(got \"a\\x00b\\x1b[31m\")") != std::string::npos);
+  CHECK(lines(n.out) == 1);
+  // tab and line breaks stay allowed (states.csv quotes them); an error line escapes them
+  std::string blow = text_of(input("blow_up.json"));
+  blow.replace(blow.find("\"ball_0\""), 8, R"("ball\n\tzero")");
+  const std::string blow_path = tmp("blow_up_named.json");
+  write_text(blow_path, blow);
+  const CommandResult b = scene(blow_path + " --steps 50 --no-render --out " + tmp("blow_up_named"));
+  INFO(b.out);
+  CHECK(b.code == 2);
+  CHECK(b.out.find("body 1 'ball\\n\\tzero': speed") != std::string::npos);
+}
+
+TEST_CASE("scene files: a finite quaternion of any size is normalised, below norm 1e-12 the error says so", "[reliability]") {
+  // [1e300, 1e300, 0, 0] was refused as "not finite": its norm overflowed
+  const std::string big = tmp("big_quaternion.json"), tiny = tmp("tiny_quaternion.json");
+  write_text(big, R"({"bodies": [{"orientation": [1e300, 1e300, 0, 0], "shapes": [{"size": 0.01}]}]})");
+  write_text(tiny, R"({"bodies": [{"orientation": [1e-13, 0, 0, 0], "shapes": [{"size": 0.01}]}]})");
+  const std::string q_out = tmp("big_quaternion_out");
+  const CommandResult q = scene(big + " --steps 1 --no-render --out " + q_out);
+  INFO(q.out);
+  CHECK(q.code == 0);
+  CHECK(text_of(q_out + "/states.csv").find("0,0,0,body_0,0,0,0,0.7071067812,0.7071067812,0,0\n") != std::string::npos);
+  const CommandResult t = scene(tiny + " --steps 1 --no-render --out " + tmp("tiny_quaternion_out"));
+  INFO(t.out);
+  CHECK(t.code == 1);
+  CHECK(t.out.find("bodies[0].orientation: must be a quaternion [w, x, y, z] of norm >= 1e-12 (got norm 1e-13)") !=
+        std::string::npos);
+}
+
+TEST_CASE("magsim-scene: a dangling --out symlink is named as one, exit 3", "[reliability]") {
+  // "File exists" before
+  const std::string link = tmp("dangling_out");
+  REQUIRE(::symlink((link + "_target").c_str(), link.c_str()) == 0);
+  const CommandResult d = scene("balls_up --count 3 --steps 1 --no-render --out " + link);
+  INFO(d.out);
+  CHECK(d.code == 3);
+  CHECK(d.out.find("is a symbolic link to " + link + "_target, which does not exist") != std::string::npos);
+  CHECK(lines(d.out) == 1);
+}

@@ -29,6 +29,9 @@ std::string csv_field(const std::string& v) {
 // Any failure here is an I/O error (exit 3).
 void prepare_out_dir(const std::string& dir) {
   std::error_code ec;
+  if (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec))
+    throw IoError("--out " + dir + ": is a symbolic link to " + fs::read_symlink(dir, ec).string() +
+                  ", which does not exist");
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw IoError("--out " + dir + ": exists and is not a directory");
   fs::create_directories(dir, ec);

@@ -252,11 +252,12 @@ int run(const Args& a, const CLI::App& app) {
     return kIoError;
   }
   if (!io_error.empty()) {
-    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", io_error.c_str(), path.c_str());
+    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", tools::one_line(io_error).c_str(), path.c_str());
     return kIoError;
   }
   if (!error.empty()) {
-    std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
+    std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", tools::one_line(error).c_str(),
+                 path.c_str());
     return kRunFailed;
   }
   const mag::FieldOptions& fo = model.options.magnetics.field;
