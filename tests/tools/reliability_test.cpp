@@ -58,6 +58,11 @@ mode_t kind_at(const std::string& path) {
   return ::lstat(path.c_str(), &st) == 0 ? (st.st_mode & S_IFMT) : 0;
 }
 
+long long size_of(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<long long>(st.st_size) : -1;
+}
+
 // How a child process ended: its exit code, or the signal that killed it.
 struct Ended {
   bool signaled = false;
@@ -104,6 +109,16 @@ Ended wait_for(pid_t pid, std::chrono::seconds limit = std::chrono::seconds(120)
   return e;
 }
 
+// Polls `done` every 10 ms for at most 60 s.
+bool wait_until(const std::function<bool()>& done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
 // `sh -c cmd` with its stdout on a pipe whose reader is gone (as `| head -1` after its line)
 Ended run_into_closed_pipe(const std::string& cmd) {
   int fds[2];
@@ -112,6 +127,13 @@ Ended run_into_closed_pipe(const std::string& cmd) {
   const pid_t pid = spawn(cmd, fds[1]);
   ::close(fds[1]);
   return wait_for(pid);
+}
+
+// A balls_up run long enough to be caught mid-run (100000 steps of 244 bodies, every step a
+// frame); `exec`, so a signal to the pid reaches the program.
+std::string long_run(const std::string& out) {
+  return std::string("exec ") + MAGSIM_SCENE_BIN + " balls_up --steps 100000 --no-render --threads 1 --fps 1000 --out " +
+         out + " 2>/dev/null";
 }
 
 // every line of the CSV has `fields` fields and the file ends with a line break
@@ -790,4 +812,27 @@ TEST_CASE("magsim-scene: a dangling --out symlink is named as one, exit 3", "[re
   CHECK(d.code == 3);
   CHECK(d.out.find("is a symbolic link to " + link + "_target, which does not exist") != std::string::npos);
   CHECK(lines(d.out) == 1);
+}
+
+TEST_CASE("magsim-scene: SIGTERM, SIGINT or SIGHUP mid-run ends with whole CSV rows, an interrupted summary, exit 128 + signal", "[reliability]") {
+  for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string out = tmp("signal_" + std::to_string(sig));
+    const pid_t pid = spawn(long_run(out));
+    // a few frames in, and mid-way through writing more
+    const bool running = wait_until([&] { return size_of(out + "/states.csv") > 200000; });
+    ::kill(pid, sig);
+    REQUIRE(running);
+    const Ended e = wait_for(pid);
+    INFO("signal " << sig << ": " << (e.signaled ? "killed by signal " : "exit ") << e.code);
+    CHECK(!e.signaled);
+    CHECK(e.code == 128 + sig);
+    const auto summary = nlohmann::json::parse(text_of(out + "/summary.json"));
+    CHECK(summary["interrupted"] == true);
+    CHECK(summary["signal"] == (sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "SIGHUP"));
+    CHECK(summary["error"].is_null());
+    CHECK(summary["steps"].get<long>() < 100000);
+    CHECK(summary["frames"].get<long>() == summary["steps"].get<long>() + 1);  // a frame a step, from step 0
+    check_whole_rows(out + "/states.csv", 11);
+    check_whole_rows(out + "/moments.csv", 16);
+  }
 }
