@@ -836,3 +836,23 @@ TEST_CASE("magsim-scene: SIGTERM, SIGINT or SIGHUP mid-run ends with whole CSV r
     check_whole_rows(out + "/moments.csv", 16);
   }
 }
+
+TEST_CASE("magsim-scene: a second run into an output folder in use is refused, exit 1, and leaves the first's files", "[reliability]") {
+  const std::string out = tmp("locked");
+  const pid_t pid = spawn(long_run(out));
+  const bool running = wait_until([&] { return size_of(out + "/states.csv") > 0; });
+  const CommandResult second = running ? scene("balls_up --count 5 --steps 1 --no-render --out " + out) : CommandResult{};
+  const bool first_files = size_of(out + "/states.csv") > 0;
+  ::kill(pid, SIGTERM);
+  const Ended first = wait_for(pid);
+  REQUIRE(running);
+  INFO(second.out);
+  CHECK(second.code == 1);
+  CHECK(second.out.find("another run is writing into this folder") != std::string::npos);
+  CHECK(lines(second.out) == 1);
+  CHECK(first_files);
+  CHECK(!first.signaled);
+  CHECK(nlohmann::json::parse(text_of(out + "/summary.json"))["steps_requested"] == 100000);  // the first run's
+  // the lock ends with the run that held it
+  CHECK(scene("balls_up --count 5 --steps 1 --no-render --out " + out).code == 0);
+}

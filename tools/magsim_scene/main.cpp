@@ -228,7 +228,8 @@ int main(int argc, char** argv) {
                                       "Runs longer than 1e7 rigid steps are refused; so are scene files that are not regular "
                                       "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
-                                      "(summary.json: \"interrupted\": true) and exits 128 + the signal."));
+                                      "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
+                                      "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
   if (const int code = tools::parse_command_line(app, argc, argv, "error: "); code >= 0) return code;
   if (const std::string e = tools::omp_num_threads_error(); !e.empty()) {
     std::fprintf(stderr, "error: %s\n", e.c_str());

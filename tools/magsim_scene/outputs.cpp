@@ -4,6 +4,10 @@
 
 #include <fstream>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 namespace magsim::scene_tool {
 
 bool is_output_name(const std::string& f) {
@@ -26,8 +30,12 @@ std::string csv_field(const std::string& v) {
   return q + "\"";
 }
 
-// Any failure here is an I/O error (exit 3).
-void prepare_out_dir(const std::string& dir) {
+OutDirLock::~OutDirLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+// Any failure here is an I/O error (exit 3), but for a folder another run holds (exit 1).
+OutDirLock prepare_out_dir(const std::string& dir) {
   std::error_code ec;
   if (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec))
     throw IoError("--out " + dir + ": is a symbolic link to " + fs::read_symlink(dir, ec).string() +
@@ -36,6 +44,12 @@ void prepare_out_dir(const std::string& dir) {
     throw IoError("--out " + dir + ": exists and is not a directory");
   fs::create_directories(dir, ec);
   if (ec) throw IoError("--out " + dir + ": cannot create the directory (" + ec.message() + ")");
+  const std::string lock_path = (fs::path(dir) / ".magsim.lock").string();
+  OutDirLock lock(::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666));
+  if (lock.fd() < 0) throw IoError("--out " + dir + ": cannot create " + lock_path + " (" + errno_text() + ")");
+  if (::flock(lock.fd(), LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK)
+    throw UsageError("--out " + dir + ": another run is writing into this folder (it holds " + lock_path +
+                     "); wait for it or choose another --out");
   const fs::path probe = fs::path(dir) / ".magsim_write_test";
   {
     std::ofstream f(probe);
@@ -50,6 +64,7 @@ void prepare_out_dir(const std::string& dir) {
       throw IoError("--out " + dir + ": cannot delete the old " + e.path().filename().string() + " (" + ec.message() + ")");
   }
   if (ec) throw IoError("--out " + dir + ": cannot list the directory (" + ec.message() + ")");
+  return lock;
 }
 
 

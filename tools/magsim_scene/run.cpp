@@ -131,7 +131,7 @@ int run(const Args& a, const CLI::App& app) {
   // from here on the folder is touched: a stop signal ends the run cleanly, not the process
   // (before, nothing of this run is on disk and the default action applies)
   catch_stop_signals();
-  prepare_out_dir(dir);
+  const OutDirLock lock = prepare_out_dir(dir);
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
