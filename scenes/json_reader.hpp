@@ -122,10 +122,20 @@ class JsonReader {
     if (v.size() != 4) fail(path, "must be 4 numbers [w, x, y, z]");
     const Eigen::Quaterniond q(v[0], v[1], v[2], v[3]);
     const double n = q.norm();
-    if (n < 1e-12) fail(path, "must be a non-zero quaternion [w, x, y, z]");
     // a unit quaternion up to rounding is kept bit for bit: a written scene (--write-scene)
     // then reloads to the same state hash
-    return std::abs(n - 1.0) <= 1e-12 ? q : q.normalized();
+    if (std::abs(n - 1.0) <= 1e-12) return q;
+    if (std::isfinite(n) && n >= 1e-12) return q.normalized();
+    // the norm over- or underflowed: scaled by the largest component first, any finite
+    // quaternion of norm >= 1e-12 ([1e300, 1e300, 0, 0] too) is normalised
+    const Eigen::Vector4d c(v[0], v[1], v[2], v[3]);
+    const double big = c.cwiseAbs().maxCoeff();
+    if (big == 0.0) fail(path, "must be a non-zero quaternion [w, x, y, z]");
+    const Eigen::Vector4d u = c / big;
+    if (big * u.norm() < 1e-12)
+      fail(path, "must be a quaternion [w, x, y, z] of norm >= 1e-12 (got norm " + fmt(big * u.norm()) + ")");
+    const Eigen::Vector4d unit = u / u.norm();
+    return Eigen::Quaterniond(unit[0], unit[1], unit[2], unit[3]);
   }
   render::Color color(const nlohmann::json& j, const std::string& path) const {
     const std::vector<double> v = numbers(j, path, "3 numbers [r, g, b] in [0, 1]");

@@ -61,14 +61,13 @@
 #include "scenes/json_reader.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/json_unique_keys.hpp"
+#include "scenes/text_file.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
+#include <cstdio>
 #include <initializer_list>
-#include <sstream>
 #include <stdexcept>
 
 namespace magsim::scenes {
@@ -170,12 +169,44 @@ MomentDesc read_moment(const JsonReader& r, const json& j, const std::string& pa
   return m;
 }
 
+// `s` for an error line: control bytes as \n, \t, \xNN; cut after about 60 bytes (at a
+// UTF-8 character boundary)
+std::string escaped(const std::string& s) {
+  std::string e;
+  std::size_t i = 0;
+  for (; i < s.size() && (e.size() < 60 || (static_cast<unsigned char>(s[i]) & 0xc0) == 0x80); ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    char hex[5];
+    std::snprintf(hex, sizeof hex, "\\x%02x", c);
+    if (c == '\n') e += "\\n";
+    else if (c == '\r') e += "\\r";
+    else if (c == '\t') e += "\\t";
+    else if (c < 0x20 || c == 0x7f) e += hex;
+    else e += s[i];
+  }
+  return i < s.size() ? e + "..." : e;
+}
+
+// A body name is written into states.csv (quoted when it holds a comma, quote or line break)
+// and error lines: tab and line breaks are allowed, other control bytes (NUL cut the name in
+// states.csv) are refused.
+void check_body_name(const JsonReader& r, const std::string& name, const std::string& path) {
+  for (const char ch : name) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f)
+      r.fail(path, "must not contain control characters other than tab and line breaks (got \"" + escaped(name) + "\")");
+  }
+}
+
 BodyDesc read_body(const JsonReader& r, const json& j, const std::string& path, std::size_t i) {
   r.keys(j, path, {"name", "type", "position", "orientation", "velocity", "angular_velocity",
                    "density", "mass", "shapes", "moments", "color", "visible", "magnet"});
   BodyDesc b;
   b.name = "body_" + std::to_string(i);
-  if_present(j, "name", path, [&](const json& v, const std::string& p) { b.name = r.string(v, p); });
+  if_present(j, "name", path, [&](const json& v, const std::string& p) {
+    b.name = r.string(v, p);
+    check_body_name(r, b.name, p);
+  });
   if_present(j, "type", path, [&](const json& v, const std::string& p) { b.type = body_type(r, v, p); });
   if_present(j, "position", path, [&](const json& v, const std::string& p) { b.position = r.bounded(v, p, engine::limits::kMaxCoordinate, "m"); });
   if_present(j, "orientation", path, [&](const json& v, const std::string& p) { b.orientation = r.quat(v, p); });
@@ -256,7 +287,7 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
   json doc;
   try {
     doc = parse_unique_keys(text, /*ignore_comments=*/true);
-  } catch (const DuplicateKeyError& e) {  // "bodies[0].position: duplicate key"
+  } catch (const JsonStructureError& e) {  // "bodies[0].position: duplicate key", too deep, a NUL
     r.fail("", e.what());
   } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
     std::string what = e.what();
@@ -288,15 +319,13 @@ SceneDesc parse_scene_json(const std::string& text, const std::string& origin) {
 }
 
 SceneDesc load_scene_file(const std::string& path) {
-  // a directory opens as an ifstream and reads as empty ("malformed JSON" would mislead)
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory, not a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open the scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw std::runtime_error(path + ": cannot read the scene file");
-  return parse_scene_json(text.str(), path);
+  std::string text;
+  try {
+    text = read_text_file(path);  // regular files only, at most kMaxInputBytes
+  } catch (const InputFileError& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  return parse_scene_json(text, path);
 }
 
 // ---- writing (the inverse of the reader above: every field, so a scene reloads as it was) ----

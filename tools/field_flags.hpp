@@ -4,6 +4,7 @@
 #pragma once
 
 #include "magnetics/dipole_field.hpp"
+#include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -26,7 +27,7 @@ struct FieldFlags {
     theta_opt = app->add_option("--bh-theta", theta, "Barnes-Hut opening angle, in (0, 1]")
                     ->capture_default_str();
     threshold_opt = app->add_option("--bh-threshold", threshold, "auto: moments from which Barnes-Hut is used")
-                        ->check(CLI::Range(0, 1000000000))
+                        ->check(Range(0, 1000000000))
                         ->capture_default_str();
   }
   bool has_solver() const { return solver_opt && solver_opt->count() > 0; }

@@ -10,6 +10,7 @@
 #include "scenes/json_reader.hpp"
 #include "scenes/json_unique_keys.hpp"
 #include "scenes/options_json.hpp"
+#include "scenes/text_file.hpp"
 #include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
@@ -21,10 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 #include <numeric>
 #include <stdexcept>
 
@@ -38,6 +36,7 @@ using magsim::tools::kBadInput;
 using magsim::tools::kIoError;
 using magsim::tools::kOk;
 using magsim::tools::kRunFailed;
+using magsim::tools::one_line;
 
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -132,23 +131,6 @@ void check_separations(const mag::MomentSet& set) {
 
 json vec_json(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-// The whole file as text. A directory opens as an ifstream on Linux and throws
-// std::ios_failure on the first read, so it is refused by name first.
-std::string read_text(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError("is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot read file");
-  std::ostringstream text;
-  try {
-    text << in.rdbuf();
-  } catch (const std::exception& e) {
-    throw InputError(std::string("cannot read file (") + e.what() + ")");
-  }
-  if (in.bad()) throw InputError("cannot read file");
-  return text.str();
-}
-
 // The Newton reference holds the dense 3N x 3N interaction matrix T, the Jacobian and its
 // LU factors (N induced moments): three matrices of doubles. Above this bound magsolve
 // refuses up front instead of dying in bad_alloc or paging for hours.
@@ -179,7 +161,7 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration")
       ->capture_default_str();
-  app.add_option("--max-iter", max_iter, "iteration cap")->capture_default_str();
+  app.add_option("--max-iter", max_iter, "iteration cap")->check(magsim::tools::Decimal)->capture_default_str();
   app.add_option("--softening", softening,
                  "softening length ε in metres (0 = off; needed for two moments closer than half "
                  "the sum of their radii, a = the radius of a sphere of the moment's volume)")
@@ -187,14 +169,19 @@ int run(int argc, char** argv) {
   app.add_option("--residual-tol", residual_tol,
                  "\"converged\" needs the iteration to stop (--tol) and every induced moment's "
                  "|M - f(H)| <= this x max(|M|, |f(H)|)")
-      ->check(CLI::PositiveNumber)->capture_default_str();
+      ->check(magsim::tools::PositiveNumber)->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
   app.footer(magsim::tools::exit_codes_footer(
       "bad input or flags", "the solve failed", "the output could not be written",
       "The Newton reference needs three dense 3N x 3N matrices for N induced moments; above 2 GiB "
-      "(N > 3153) magsolve refuses the case (exit 1)."));
-  if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
+      "(N > 3153) magsolve refuses the case (exit 1). So it does a CASE that is not a regular file "
+      "or is larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores."));
+  if (const int code = magsim::tools::parse_command_line(app, argc, argv, "magsolve: "); code >= 0) return code;
+  if (const std::string e = magsim::tools::omp_num_threads_error(); !e.empty()) {
+    std::fprintf(stderr, "magsolve: %s\n", e.c_str());
+    return kBadInput;
+  }
 
   if (!std::isfinite(residual_tol)) {
     std::fprintf(stderr, "magsolve: --residual-tol: must be a finite number > 0\n");
@@ -208,11 +195,16 @@ int run(int argc, char** argv) {
   }
   mag::MomentSet set;
   try {
-    const std::string text = read_text(path);
+    std::string text;
+    try {
+      text = magsim::scenes::read_text_file(path);  // regular files only, at most 1 GiB
+    } catch (const magsim::scenes::InputFileError& e) {
+      throw InputError(e.what());
+    }
     json doc;
     try {
       doc = magsim::scenes::parse_unique_keys(text);
-    } catch (const magsim::scenes::DuplicateKeyError& e) {
+    } catch (const magsim::scenes::JsonStructureError& e) {  // a duplicate key, too deep, a NUL
       throw InputError(e.what());
     } catch (const json::exception& e) {  // syntax errors and numbers out of range
       throw InputError(std::string("malformed JSON: ") + e.what());
@@ -244,10 +236,10 @@ int run(int argc, char** argv) {
     }
     if (opt.field.softening == 0.0) check_separations(set);
   } catch (const InputError& e) {
-    std::fprintf(stderr, "magsolve: %s: %s\n", path.c_str(), e.what());
+    std::fprintf(stderr, "magsolve: %s: %s\n", one_line(path).c_str(), one_line(e.what()).c_str());
     return kBadInput;
   } catch (const std::runtime_error& e) {  // JsonReader: "<file>: <json path>: <what>"
-    std::fprintf(stderr, "magsolve: %s\n", e.what());
+    std::fprintf(stderr, "magsolve: %s\n", one_line(e.what()).c_str());
     return kBadInput;
   }
 
@@ -334,6 +326,7 @@ int run(int argc, char** argv) {
                          "f(H): relative residual %.3g at moments[%zu] > --residual-tol %g; "
                          "\"converged\": false\n", residual, worst, residual_tol);
 
+  errno = 0;  // the cause of a failed write below
   if (format == "json") {
     json out;
     out["method"] = mag::method_name(opt.method);
@@ -372,25 +365,19 @@ int run(int argc, char** argv) {
                   Fc[j].y(), Fc[j].z());
     }
   }
-  // a full disk or a closed pipe must not pass as success: flush and check both streams
-  std::cout.flush();
-  const bool written = std::cout.good() && std::fflush(stdout) == 0 && !std::ferror(stdout);
-  if (!written) {
-    std::fprintf(stderr, "magsolve: writing the results to stdout failed (%s)\n",
-                 errno ? std::strerror(errno) : "stream error");
-    return kIoError;
-  }
-  return kOk;
+  // a full disk or a closed pipe (EPIPE: SIGPIPE is ignored) must not pass as success
+  return magsim::tools::stdout_written("magsolve: ", "the results") ? kOk : kIoError;
 }
 
 }  // namespace
 
 // Anything not caught above (e.g. std::bad_alloc) ends in one line and exit 2, not abort().
 int main(int argc, char** argv) {
+  magsim::tools::ignore_write_signals();
   try {
     return run(argc, argv);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "magsolve: error: %s\n", e.what());
+    std::fprintf(stderr, "magsolve: error: %s\n", one_line(e.what()).c_str());
     return kRunFailed;
   }
 }

@@ -5,9 +5,10 @@
 #include "scenes/scene_file.hpp"
 #include "tools/magsim_scene/magsim_scene.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <thread>
+#include <utility>
 
 namespace magsim::scene_tool {
 
@@ -33,12 +34,6 @@ std::string registry_names() {
 
 
 namespace {
-
-// --threads above 4x the cores only slows the run down, and 1e5 makes libgomp crash
-int max_threads() {
-  const unsigned cores = std::thread::hardware_concurrency();
-  return 4 * static_cast<int>(cores > 0 ? cores : 1);
-}
 
 // the value of an on | off flag
 bool on_off(const char* flag, const std::string& value) {
@@ -74,9 +69,9 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
     throw UsageError("unknown method '" + a.method + "'");
   if (app.count("--threads")) {
-    if (a.threads > max_threads())
-      throw UsageError("--threads: at most " + std::to_string(max_threads()) + " (4 x the " +
-                       std::to_string(max_threads() / 4) + " cores), got " + std::to_string(a.threads));
+    if (a.threads > tools::max_threads())
+      throw UsageError("--threads: at most " + std::to_string(tools::max_threads()) + " (4 x the " +
+                       std::to_string(tools::max_threads() / 4) + " cores), got " + std::to_string(a.threads));
     s.options.threads = a.threads;
   }
   if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
@@ -121,7 +116,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
 
 namespace {
 
-// --seconds / --fps: CLI::PositiveNumber lets nan and inf through
+// --seconds: a number > 0 that is also finite (PositiveNumber lets inf through)
 const auto kFinitePositive = CLI::Validator(
     [](std::string& v) -> std::string {
       try {
@@ -151,7 +146,10 @@ const auto kEven = CLI::Validator(
 
 using namespace magsim::scene_tool;
 
+namespace tools = magsim::tools;
+
 int main(int argc, char** argv) {
+  tools::ignore_write_signals();
   CLI::App app{"magsim-scene: run one scene with one method and write summary.json, states.csv and "
                "moments.csv"};
   Args a;
@@ -164,26 +162,26 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(scenes::method_names()));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(kFinitePositive);
-  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(CLI::Range(1L, static_cast<long>(kMaxSteps)));
+  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(tools::Range(1L, static_cast<long>(kMaxSteps)));
   seconds->excludes(steps);
   steps->excludes(seconds);
   app.add_option("--out", a.out, "output directory (default: out/<scene>_<method>)");
   app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60), in [0.001, 1e9]")
-      ->check(kFinitePositive & CLI::Range(1e-3, 1e9));
+      ->check(tools::Range(1e-3, 1e9));
   app.add_flag("--no-render", a.no_render, "do not render frames");
-  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
-  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(CLI::Range(16, 8192) & kEven)->capture_default_str();
-  app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(CLI::Range(1, 4))->capture_default_str();
+  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(tools::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(tools::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(tools::Range(1, 4))->capture_default_str();
   app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
-  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores")->check(CLI::Range(1, 1000000000));
-  app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(CLI::Range(1, 1000000000));
-  app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(CLI::PositiveNumber);
-  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(CLI::PositiveNumber);
-  app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(CLI::PositiveNumber);
-  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(CLI::Range(1, 1000000000));
+  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores")->check(tools::Range(1, 1000000000));
+  app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(tools::Range(1, 1000000000));
+  app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(tools::PositiveNumber);
+  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(tools::PositiveNumber);
+  app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(tools::PositiveNumber);
+  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(tools::Range(1, 1000000000));
   app.add_option("--quickstep-iterations", a.quickstep_iterations,
                  "ODE QuickStep (contact solver) iterations per rigid step (default: the scene's, 20)")
-      ->check(CLI::Range(1, 100000));
+      ->check(tools::Range(1, 100000));
   app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   app.add_option("--force-model", a.force_model,
@@ -207,10 +205,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-substeps", a.max_substeps,
                  "most rigid sub-steps per frame; a frame is split when bodies touching each other move fast or bodies "
                  "in contact are pressed hard by the magnetic force (1 = never; default: the scene's)")
-      ->check(CLI::Range(1, 64));
+      ->check(tools::Range(1, 64));
   app.add_option("--substep-reach", a.substep_reach,
                  "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
-      ->check(CLI::PositiveNumber);
+      ->check(tools::PositiveNumber);
   app.add_option("--substep-load", a.substep_load,
                  "on | off: also split a frame by the magnetic acceleration a of bodies in contact, "
                  "a h^2 <= reach * r_min per sub-step (default on)");
@@ -220,24 +218,24 @@ int main(int argc, char** argv) {
                  "reaction-symmetric forces (default: the scene's, off in every registry scene)");
   app.add_option("--rolling-friction", a.rolling_friction,
                  "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tools::NonNegativeNumber);
   app.add_option("--rolling-friction-bodies", a.rolling_friction_bodies,
                  "the same between two dynamic bodies (a ball rolling on a ball), rho (m) (0 = none; default: the scene's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tools::NonNegativeNumber);
   app.add_option("--eddy-conductivity", a.eddy_conductivity,
                  "electrical conductivity sigma (S/m) of the induced bodies: eddy-current loss where their flux "
                  "density changes in their own frame (iron 1e7; 0 = none; default: the scene's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tools::NonNegativeNumber);
   app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
-      ->check(CLI::Range(1e-6, 1.999999));
+      ->check(tools::Range(1e-6, 1.999999));
   app.add_option("--dt", a.dt, "rigid (frame) step dt_r in seconds, (0, 0.1] (default: the scene's, 1e-3)")
-      ->check(CLI::Range(1e-7, 0.1));
+      ->check(tools::Range(1e-7, 0.1));
   app.add_option("--bounded-pairs", a.bounded_pairs,
                  "on | off: evaluate a pair of moments no closer than the sum of their interaction radii (default: the scene's, off)");
   app.add_option("--softening", a.softening,
                  "dipole softening length eps (m): |r|^2 -> |r|^2 + eps^2 in every field, Jacobian and "
                  "force, in [0, 0.1] (default: the scene's)")
-      ->check(CLI::Range(0.0, 0.1));
+      ->check(tools::Range(0.0, 0.1));
   a.field.add(&app,
               "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
@@ -249,32 +247,42 @@ int main(int argc, char** argv) {
 
   app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
                                       "an output file could not be written",
-                                      "Runs longer than 1e7 rigid steps are refused."));
-  if (const int code = magsim::tools::parse_command_line(app, argc, argv); code >= 0) return code;
+                                      "Runs longer than 1e7 rigid steps are refused; so are scene files that are not regular "
+                                      "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n"
+                                      "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
+                                      "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
+                                      "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
+  if (const int code = tools::parse_command_line(app, argc, argv, "error: "); code >= 0) return code;
+  if (const std::string e = tools::omp_num_threads_error(); !e.empty()) {
+    std::fprintf(stderr, "error: %s\n", e.c_str());
+    return kBadInput;
+  }
   if (a.list) {
+    errno = 0;
     for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
-    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-      std::fprintf(stderr, "error: writing the list to stdout failed (%s)\n", errno_text().c_str());
-      return kIoError;
-    }
-    return kOk;
+    return tools::stdout_written("error: ", "the list") ? kOk : kIoError;
   }
   if (a.scene.empty()) {
     std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
     return kBadInput;
   }
+  // an empty name would be ignored (--write-scene) or fail as a folder (--out)
+  for (const auto& [flag, path] : {std::pair<const char*, const std::string&>{"--write-scene", a.write_scene}, {"--out", a.out}})
+    if (app.count(flag) && path.empty()) {
+      std::fprintf(stderr, "error: %s: needs a non-empty path\n", flag);
+      return kBadInput;
+    }
   try {
-    if (!a.write_scene.empty()) return write_scene(a, app);
+    if (app.count("--write-scene")) return write_scene(a, app);
     return run(a, app);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", tools::one_line(e.what()).c_str());
     return kBadInput;
   } catch (const IoError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", tools::one_line(e.what()).c_str());
     return kIoError;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", tools::one_line(e.what()).c_str());
     return kRunFailed;
   }
 }
-

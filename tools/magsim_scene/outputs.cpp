@@ -4,11 +4,17 @@
 
 #include <fstream>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 namespace magsim::scene_tool {
 
 bool is_output_name(const std::string& f) {
   for (const char* n : kOutputNames)
     if (f == n) return true;
+  // summary.json's temporary file (tools/replace_file.hpp), left by a killed run
+  if (f.size() == 20 && f.compare(0, 14, ".summary.json.") == 0) return true;
   // frame_%06d.png (six or more digits)
   const std::size_t digits = f.size() >= 10 ? f.size() - 10 : 0;
   if (f.size() < 16 || f.compare(0, 6, "frame_") != 0 || f.compare(f.size() - 4, 4, ".png") != 0) return false;
@@ -24,13 +30,26 @@ std::string csv_field(const std::string& v) {
   return q + "\"";
 }
 
-// Any failure here is an I/O error (exit 3).
-void prepare_out_dir(const std::string& dir) {
+OutDirLock::~OutDirLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+// Any failure here is an I/O error (exit 3), but for a folder another run holds (exit 1).
+OutDirLock prepare_out_dir(const std::string& dir) {
   std::error_code ec;
+  if (fs::is_symlink(fs::symlink_status(dir, ec)) && !fs::exists(dir, ec))
+    throw IoError("--out " + dir + ": is a symbolic link to " + fs::read_symlink(dir, ec).string() +
+                  ", which does not exist");
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     throw IoError("--out " + dir + ": exists and is not a directory");
   fs::create_directories(dir, ec);
   if (ec) throw IoError("--out " + dir + ": cannot create the directory (" + ec.message() + ")");
+  const std::string lock_path = (fs::path(dir) / ".magsim.lock").string();
+  OutDirLock lock(::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666));
+  if (lock.fd() < 0) throw IoError("--out " + dir + ": cannot create " + lock_path + " (" + errno_text() + ")");
+  if (::flock(lock.fd(), LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK)
+    throw UsageError("--out " + dir + ": another run is writing into this folder (it holds " + lock_path +
+                     "); wait for it or choose another --out");
   const fs::path probe = fs::path(dir) / ".magsim_write_test";
   {
     std::ofstream f(probe);
@@ -39,10 +58,13 @@ void prepare_out_dir(const std::string& dir) {
   fs::remove(probe, ec);
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     if (!is_output_name(e.path().filename().string()) || e.is_directory(ec)) continue;
+    if (!e.is_symlink(ec) && !e.is_regular_file(ec))  // a FIFO or device is not an old output
+      throw IoError("--out " + dir + ": " + e.path().filename().string() + " is not a regular file; it is not replaced");
     if (!fs::remove(e.path(), ec) && ec)
       throw IoError("--out " + dir + ": cannot delete the old " + e.path().filename().string() + " (" + ec.message() + ")");
   }
   if (ec) throw IoError("--out " + dir + ": cannot list the directory (" + ec.message() + ")");
+  return lock;
 }
 
 

@@ -34,9 +34,25 @@ bool is_output_name(const std::string& f);
 // RFC 4180: a field with a comma, quote or line break is quoted, quotes doubled; other
 // fields are written as they are (so ordinary output does not change)
 std::string csv_field(const std::string& v);
-// Creates DIR (and parents), checks that files can be written into it and deletes the
-// outputs of an earlier run there (only this program's own names, see is_output_name).
-void prepare_out_dir(const std::string& dir);
+// The lock a run holds on its output folder (an flock on DIR/.magsim.lock) until it ends, so
+// two runs never mix their files in one folder.
+class OutDirLock {
+ public:
+  explicit OutDirLock(int fd) : fd_(fd) {}
+  OutDirLock(OutDirLock&& o) noexcept : fd_(o.fd_) { o.fd_ = -1; }
+  OutDirLock(const OutDirLock&) = delete;
+  OutDirLock& operator=(const OutDirLock&) = delete;
+  ~OutDirLock();
+  int fd() const { return fd_; }
+
+ private:
+  int fd_;
+};
+// Creates DIR (and parents), locks it (UsageError when another run holds it), checks that
+// files can be written into it and deletes the outputs of an earlier run there (only this
+// program's own names, see is_output_name; one that is not a regular file or a symlink is
+// refused, not deleted).
+OutDirLock prepare_out_dir(const std::string& dir);
 // summary.json "energy" (outputs.cpp)
 json energy_json(const engine::Simulation& sim);
 

@@ -14,14 +14,15 @@
 #include "scenes/options_json.hpp"
 #include "scenes/scene_file.hpp"
 #include "tools/magsim_scene/outputs.hpp"
+#include "tools/replace_file.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -47,6 +48,36 @@ double sum(const std::vector<double>& v) {
   double s = 0;
   for (double x : v) s += x;
   return s;
+}
+
+// The signal that asked the run to stop (0: none). Read once per step: no syscall.
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
+
+// SIGINT, SIGTERM and SIGHUP stop the run after the step it is in: whole CSV rows, summary.json
+// with "interrupted": true, exit 128 + the signal. Repeats are caught too (a second one
+// must not cut a row in half either); SIGKILL remains for a step that will not end. A signal
+// the caller ignores stays ignored (nohup, background jobs of a shell).
+void catch_stop_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction before {};
+    if (sigaction(sig, nullptr, &before) == 0 && before.sa_handler == SIG_IGN) continue;
+    sigaction(sig, &sa, nullptr);
+  }
+}
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+  }
+  return "a signal";
 }
 
 }  // namespace
@@ -97,7 +128,10 @@ int run(const Args& a, const CLI::App& app) {
       if (fs::equivalent(fs::path(dir) / n, a.scene, ec))
         throw UsageError("--out " + dir + ": the output " + n + " would overwrite the input scene file " + a.scene);
     }
-  prepare_out_dir(dir);
+  // from here on the folder is touched: a stop signal ends the run cleanly, not the process
+  // (before, nothing of this run is on disk and the default action applies)
+  catch_stop_signals();
+  const OutDirLock lock = prepare_out_dir(dir);
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
@@ -122,6 +156,7 @@ int run(const Args& a, const CLI::App& app) {
   try {
     if (rec.frame()) painter.draw(sim);
     for (long k = 0; k < n_steps; ++k) {
+      if (g_stop_signal) break;
       if (adaptive) sim.limit_default_threads(governor.threads());
       threads.push_back(sim.threads());
       try {
@@ -167,6 +202,8 @@ int run(const Args& a, const CLI::App& app) {
     if (io_error.empty()) io_error = e.what();
   }
   const double wall = std::chrono::duration<double>(clock::now() - t0).count();
+  // a signal during the last step still marks the run: the summary then says what it saw
+  const int stop = g_stop_signal;
 
   const engine::Metrics fin = sim.metrics();
   char hash[19];
@@ -241,32 +278,34 @@ int run(const Args& a, const CLI::App& app) {
       {"energy", energy_json(sim)},
       {"series", rec.series()},
       {"state_hash", hash},
+      // stopped by SIGINT, SIGTERM or SIGHUP after `steps` whole steps (the last good state)
+      {"interrupted", stop != 0},
+      {"signal", stop ? json(signal_name(stop)) : json(nullptr)},
       {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};
 
-  // written to a temporary name and renamed when complete: a full disk leaves no
-  // summary.json that looks valid
+  // written to a unique temporary name and renamed when complete (tools/replace_file.hpp): a
+  // full disk leaves no summary.json that looks valid
   const fs::path path = fs::path(dir) / "summary.json";
-  const fs::path tmp = fs::path(dir) / "summary.json.tmp";
-  {
-    std::ofstream out(tmp);
-    out << summary.dump(1) << '\n';
-    out.close();
-    std::error_code ec;
-    if (!out || (fs::rename(tmp, path, ec), ec)) {
-      const std::string why = ec ? ec.message() : errno_text();
-      fs::remove(tmp, ec);
-      std::fprintf(stderr, "error: cannot write %s (%s)%s%s\n", path.c_str(), why.c_str(),
-                   io_error.empty() ? "" : "; before that: ", io_error.c_str());
-      return kIoError;
-    }
+  try {
+    tools::replace_file(path.string(), summary.dump(1) + "\n");
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "error: cannot write %s: %s%s%s\n", path.c_str(), tools::one_line(e.what()).c_str(),
+                 io_error.empty() ? "" : "; before that: ", tools::one_line(io_error).c_str());
+    return kIoError;
   }
   if (!io_error.empty()) {
-    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", io_error.c_str(), path.c_str());
+    std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", tools::one_line(io_error).c_str(), path.c_str());
     return kIoError;
   }
   if (!error.empty()) {
-    std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", error.c_str(), path.c_str());
+    std::fprintf(stderr, "error: %s\n(summary with the last good state in %s)\n", tools::one_line(error).c_str(),
+                 path.c_str());
     return kRunFailed;
+  }
+  if (stop) {
+    std::fprintf(stderr, "%s %s: interrupted by %s after %ld of %ld steps; outputs complete to there, summary in %s\n",
+                 scene.name.c_str(), method.c_str(), signal_name(stop), sim.steps(), n_steps, path.c_str());
+    return 128 + stop;
   }
   const mag::FieldOptions& fo = model.options.magnetics.field;
   std::fprintf(stderr,
@@ -279,22 +318,19 @@ int run(const Args& a, const CLI::App& app) {
 }
 
 
-// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written to
-// FILE.tmp and renamed, so a failed write leaves no half file under the name.
+// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written whole
+// through a temporary file (tools/replace_file.hpp): a regular file or a symlink to one is
+// replaced, a missing one created; a directory, device, FIFO or dangling link is refused.
 int write_scene(const Args& a, const CLI::App& app) {
   const engine::SceneDesc scene = resolve_scene(a, app);
-  const fs::path path = a.write_scene;
-  const fs::path tmp = path.string() + ".tmp";
-  std::ofstream out(tmp);
-  out << scenes::scene_to_json(scene).dump(1) << '\n';
-  out.close();
-  std::error_code ec;
-  if (!out || (fs::rename(tmp, path, ec), ec)) {
-    const std::string why = ec ? ec.message() : errno_text();
-    fs::remove(tmp, ec);
-    throw IoError("--write-scene: cannot write " + path.string() + " (" + why + ")");
+  try {
+    tools::replace_file(a.write_scene, scenes::scene_to_json(scene).dump(1) + "\n");
+  } catch (const tools::NotARegularFile& e) {
+    throw UsageError("--write-scene " + a.write_scene + ": " + e.what());
+  } catch (const tools::WriteFailed& e) {
+    throw IoError("--write-scene: cannot write " + a.write_scene + ": " + e.what());
   }
-  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), path.c_str());
+  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), a.write_scene.c_str());
   return kOk;
 }
 
