@@ -330,7 +330,7 @@ struct OdeBridge::Impl {
     return mu * (z + std::sqrt(1.0 - z * z));
   }
 
-  int collide(std::vector<std::pair<int, int>>* pairs, double dt) {
+  int collide(std::vector<std::pair<int, int>>* pairs, double dt, double dt_soft) {
     ensure_thread_data();
     recs.clear();
     dSpaceCollide(space, this, &near_callback);
@@ -347,6 +347,23 @@ struct OdeBridge::Impl {
     std::sort(order.begin(), order.end());
     pairs->clear();
     const double touch = 0.1 * margin;  // gaps below this count as touching (metrics)
+    // The contacts' softness for a step of dt: the spring and damper that ERP and CFM make at
+    // the step dt_soft (kp = ERP/(CFM dt_soft), kd = (1 − ERP)/CFM), kept at dt:
+    //   ERP_dt = dt kp/(dt kp + kd),  CFM_dt = 1/(dt kp + kd).
+    // With ERP and CFM fixed instead, an overlap d is pushed out at ERP d/dt: n times faster
+    // in n sub-steps, so the energy guard's retakes fed energy into overlaps rather than
+    // resolving them (step.cpp passes the sub-step the scene chose as dt_soft).
+    double soft_erp = model.options.erp, soft_cfm = model.options.cfm;
+    const double h0 = dt_soft;
+    if (dt != h0) {
+      if (soft_cfm > 0) {
+        const double kp_h = soft_erp / soft_cfm * (dt / h0), kd = (1.0 - soft_erp) / soft_cfm;
+        soft_erp = kp_h / (kp_h + kd);
+        soft_cfm = 1.0 / (kp_h + kd);
+      } else {
+        soft_erp *= dt / h0;  // the limit of a stiff spring: the same correction rate ERP/h0
+      }
+    }
     dContact c;
     for (const auto& [key, idx] : order) {
       const ContactRec& r = recs[idx];
@@ -354,6 +371,8 @@ struct OdeBridge::Impl {
       // with its own ρ, between two bodies: three more rows on every ball–ball contact of a
       // pile doubled QuickStep's time (falling_magnet T_r 9.1 → 18.9 ms)
       c.surface = tag[r.a].dynamic && tag[r.b].dynamic ? between : rolling;
+      c.surface.soft_erp = soft_erp;
+      c.surface.soft_cfm = soft_cfm;
       c.geom = r.g;
       // true depth d = depth of the grown geoms − how far each grown geom reaches beyond
       // its shape along the contact normal (margin_along: μ for spheres and capsules, more
@@ -467,8 +486,8 @@ void OdeBridge::set_velocity(int i, const Vec3& v) {
   if (impl_->body[i]) dBodySetLinearVel(impl_->body[i], v.x(), v.y(), v.z());
 }
 
-int OdeBridge::collide(std::vector<std::pair<int, int>>* pairs, double h) {
-  return impl_->collide(pairs, h);
+int OdeBridge::collide(std::vector<std::pair<int, int>>* pairs, double h, double h_soft) {
+  return impl_->collide(pairs, h, h_soft > 0 ? h_soft : h);
 }
 
 void OdeBridge::quickstep(unsigned long seed, double h) {

@@ -152,8 +152,10 @@ struct SimOptions {
   /// never guarded): a rigid step whose E = K + U_g + U* rises by more than
   ///   energy_guard_tolerance · (K_start + K_end + |U*_start|) + energy_guard_floor
   /// is rolled back and retaken from its start in twice as many sub-steps, up to
-  /// energy_guard_max_substeps; a step still rising there is kept and counted
-  /// (EnergyAudit::guard_unresolved). K the kinetic energy at the step's ends, U* the
+  /// energy_guard_max_substeps, while each retake rises less than the one before; where E
+  /// still rises, the attempt that rose least is kept and counted
+  /// (EnergyAudit::guard_unresolved). A retake keeps the contacts' softness of the scene's
+  /// own sub-steps (OdeBridge::collide). K the kinetic energy at the step's ends, U* the
   /// co-energy at its start: the energy in play. A resting pile's contacts make E jitter by
   /// ~1e-5–1e-4 of it per step (tools/findings/energy.md); the default sits above that.
   bool energy_guard = true;

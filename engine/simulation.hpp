@@ -90,7 +90,8 @@ class Simulation {
  private:
   /// One try at the step from state_ in nsub rigid sub-steps, into ws_.next and ws_.audit
   /// (E at both ends, ws_.coenergy_start and ws_.audit.magnetic_energy); nothing committed.
-  void attempt(int nsub, long n);
+  /// The contacts are as soft as at nsub_soft sub-steps (the count the scene chose).
+  void attempt(int nsub, int nsub_soft, long n);
   /// Stages 2 and 3 at the moments' current poses: the magnetization solve (unless the
   /// magnetization is already the converged one) and the forces into ws_ (not applied).
   void solve_magnetics(bool solve, long n);

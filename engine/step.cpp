@@ -75,7 +75,7 @@ void Simulation::solve_magnetics(bool solve, long n) {
   }
 }
 
-void Simulation::attempt(int nsub, long n) {
+void Simulation::attempt(int nsub, int nsub_soft, long n) {
   const Model& m = *model_;
   StepProfile& prof = profile_;
   begin_audit_step(energy_, &ws_.audit);
@@ -122,7 +122,7 @@ void Simulation::attempt(int nsub, long n) {
       {
         ScopedTimer c(&prof.collide_ms);
         ode_->update_margins(now, ws_.body_force, h);
-        prof.contacts = ode_->collide(&ws_.next.contact_pairs, h);
+        prof.contacts = ode_->collide(&ws_.next.contact_pairs, h, m.options.dt / nsub_soft);
       }
       ScopedTimer q(&prof.quickstep_ms);
       try {
@@ -182,9 +182,13 @@ void Simulation::step() {
   try {
     // (1b) the frame's rigid sub-steps (1 unless the scene allows more and bodies move fast)
     int nsub = choose_substeps(m, state_);
+    const int nsub_scene = nsub;  // the guard's retakes keep its contact softness
     long retakes = 0, unresolved = 0;
+    int best_nsub = nsub;  // the attempt whose E rose least
+    double best_dE = 0.0;
+    bool redo_best = false;
     for (;;) {
-      attempt(nsub, n);
+      attempt(nsub, nsub_scene, n);
       // the energy guard: ΔE = E_end − E_start of the whole frame, E = K + U_g + U*
       const double e_start = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
       const double dE = total_energy(ws_.audit) - e_start;
@@ -193,10 +197,21 @@ void Simulation::step() {
                          o.energy_guard_floor;
       ws_.audit.last.energy_created = std::max(0.0, dE);
       ws_.audit.last.energy_dissipated = std::max(0.0, -dE);
-      if (!guard || !(dE > tol)) break;
-      if (nsub >= o.energy_guard_max_substeps) {
+      if (!guard || !(dE > tol) || redo_best) break;
+      const bool better = retakes == 0 || dE < best_dE;
+      if (better) {
+        best_nsub = nsub;
+        best_dE = dE;
+      }
+      if (!better || nsub >= o.energy_guard_max_substeps) {
+        // finer sub-steps did not help, or the cap: keep the attempt that rose least (retaken:
+        // states are a function of the start and the sub-step count)
         ++unresolved;
-        break;
+        if (best_nsub == nsub) break;
+        rollback();
+        nsub = best_nsub;
+        redo_best = true;
+        continue;
       }
       // retake the frame from state_ in twice as many sub-steps
       ++retakes;

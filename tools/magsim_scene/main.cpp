@@ -195,13 +195,13 @@ int main(int argc, char** argv) {
                  "there, summary.json energy.guard says so)");
   app.add_option("--energy-guard-tolerance", a.energy_guard_tolerance,
                  "the guard's tolerance relative to the step's K_start + K_end + |U*_start| (default 1e-3)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tools::NonNegativeNumber);
   app.add_option("--energy-guard-floor", a.energy_guard_floor,
                  "the guard's absolute tolerance per step, J (default 1e-6)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tools::NonNegativeNumber);
   app.add_option("--energy-guard-max-substeps", a.energy_guard_max_substeps,
                  "most sub-steps the guard retakes a frame in (default 32)")
-      ->check(CLI::Range(1, 64));
+      ->check(tools::Range(1, 64));
   app.add_option("--max-substeps", a.max_substeps,
                  "most rigid sub-steps per frame; a frame is split when bodies touching each other move fast or bodies "
                  "in contact are pressed hard by the magnetic force (1 = never; default: the scene's)")
