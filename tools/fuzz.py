@@ -117,7 +117,7 @@ def check_scene(path, out, timeout):
         return f"exit 0 with an unreadable summary.json ({e})"
     if s.get("error") is not None:
         return "exit 0 with an error in summary.json"
-    if not finite_json({k: v for k, v in s.items() if k not in ("error",)}):
+    if not finite_json({k: v for k, v in s.items() if k not in ("error", "signal")}):  # null: none
         return "exit 0 with a non-finite value in summary.json"
     with open(os.path.join(out, "states.csv"), "rb") as f:
         data = f.read()
