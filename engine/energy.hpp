@@ -1,6 +1,6 @@
-// engine/energy.hpp — the energy audit (issue #12): where the kinetic energy of bodies that
-// scatter comes from, step by step, split into the work of the magnetic forces, of gravity
-// and of the contacts.
+// engine/energy.hpp — the energy audit: where the kinetic energy of bodies that scatter comes
+// from, step by step, split into the work of the magnetic forces, of gravity and of the
+// contacts, and the total E = K + U_g + U* that a conservative force can only lose.
 //
 // Per ODE step of length h, with v, ω the velocities of a dynamic body before (−) and after
 // (+) the step:
