@@ -105,8 +105,12 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
 
     // (2), (3): the first sub-step takes the forces the last step left for this state (or,
     // after a restore or rollback, evaluates them from its converged magnetization)
-    if (k > 0 || !ws_.forces_ready) solve_magnetics(k > 0 || !state_.magnetized, n);
-    if (k == 0) ws_.coenergy_start = coenergy();
+    if (k > 0 || !ws_.forces_ready) {
+      solve_magnetics(k > 0 || !state_.magnetized, n);
+      if (k == 0) ws_.coenergy_start = coenergy();
+    } else {
+      ws_.coenergy_start = energy_.magnetic_energy;  // the last step's audit, from this field
+    }
     ws_.forces_ready = false;  // the moments move on from here
 
     if (m.dynamic_moments) {
