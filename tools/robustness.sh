@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# tools/robustness.sh — the robustness matrix of issue #12: each scene under the default
-# method with QuickStep W 1.0 and 1.3, 20 and 50 QuickStep iterations, Δt_r 0.5/1/2 ms and
-# strength ×1 and ×3 (24 runs a scene). No run may blow up: it must end without an error,
-# with finite metrics, and no body faster than the bound (default 20 m/s) at any frame.
+# tools/robustness.sh — the robustness matrix: each scene under the default method with
+# QuickStep W 1.0 and 1.3, 20 and 50 QuickStep iterations, Δt_r 0.5/1/2 ms and strength ×1
+# and ×3 (24 runs a scene). No run may blow up: it must end without an error, with finite
+# metrics, and no body faster than the bound (default 20 m/s) at any frame. Where the force
+# has an energy, E = K + U_g + U* (summary.json series energy_total, from 0.05 s on) may
+# never stand above its running minimum by more than 1 % of what the run dissipates.
 #
 #   bash tools/robustness.sh [--seconds S] [--scenes a,b] [--bound V] [--out DIR] [--quick]
 #                            [--flags "MAGSIM-SCENE FLAGS"]
@@ -55,20 +57,30 @@ for s in "${S[@]}"; do
     # shellcheck disable=SC2086  # --flags is a list of words
     "$bin" "$s" --seconds "$seconds" --no-render --fps 60 --out "$d" --quickstep-w "$w" \
         --quickstep-iterations "$it" --dt "$dt" --strength "$st" $flags >/dev/null 2>"$d.log" || true
-    row=$(python3 - "$d/summary.json" "$bound" <<'PY'
+    row=$(python3 - "$d/summary.json" "$bound" "tools" <<'PY'
 import json, math, sys
+sys.path.insert(0, sys.argv[3])
+from ensemble import energy_figures  # noqa: E402  (the ensembles' own measure of E)
 try:
     s = json.load(open(sys.argv[1]))
 except Exception as e:
-    print(f"| no summary ({e}) | | | | FAIL |"); sys.exit()
+    print(f"| no summary ({e}) | | | | | FAIL |"); sys.exit()
 bound = float(sys.argv[2])
 ser = s["series"]
 peak = max((v for v in ser["max_speed"] if v is not None), default=float("nan"))
 ke = s["final"]["kinetic_energy"]
 finite = all(v is not None and math.isfinite(v) for v in ser["max_speed"] + ser["kinetic_energy"])
 ok = s["error"] is None and finite and peak <= bound
+# the energy criterion holds where the force has one (energy.conservative)
+rise, lost, ratio = energy_figures(ser)
+if s.get("energy", {}).get("conservative") and rise is not None:
+    e_ok = rise <= 0.01 * lost if lost > 0 else rise <= 0.0
+    energy = f"{rise:.2g} of {lost:.3g}" + ("" if e_ok else " (>1 %)")
+    ok = ok and e_ok
+else:
+    energy = "no energy (eq. 4)" if not s.get("energy", {}).get("conservative") else "n/a"
 err = (s["error"] or "")[:60]
-print(f"| {peak:.3g} | {ke if ke is not None else float('nan'):.3g} | {s['substeps']['mean'] if 'substeps' in s else 1:.2f} | {err} | {'ok' if ok else 'FAIL'} |")
+print(f"| {peak:.3g} | {ke if ke is not None else float('nan'):.3g} | {energy} | {s['substeps']['mean'] if 'substeps' in s else 1:.2f} | {err} | {'ok' if ok else 'FAIL'} |")
 PY
 )
     rows+=("| $s | $w | $it | $dt | x$st $row")
@@ -76,10 +88,10 @@ PY
   done
 done
 {
-  echo "# Robustness matrix ($seconds s, default method${flags:+, $flags}; bound: no body faster than $bound m/s, finite, no error)"
+  echo "# Robustness matrix ($seconds s, default method${flags:+, $flags}; bound: no body faster than $bound m/s, finite, no error, E's rise ≤ 1 % of what is dissipated)"
   echo
-  echo "| scene | W | iterations | dt_r (s) | strength | peak speed (m/s) | final KE (J) | sub-steps/frame | error | verdict |"
-  echo "|---|---|---|---|---|---|---|---|---|---|"
+  echo "| scene | W | iterations | dt_r (s) | strength | peak speed (m/s) | final KE (J) | E rise of E lost (J) | sub-steps/frame | error | verdict |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
   printf '%s\n' "${rows[@]}"
 } > "$out/robustness.md"
 cat "$out/robustness.md"
