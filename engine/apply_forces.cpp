@@ -116,8 +116,8 @@ void torque_balance_forces(const std::vector<Vec3>& x, const std::vector<double>
 // effective moments m̃ (tests/magnetics/forces_test.cpp; m̃_j ∥ H_j once M_j ∥ H_j). ℓ_j
 // vanishes when every source's effective moment is the same multiple of its moment; it does
 // not where iron (m̃ ≈ 2(χ+1) m in the linear range) meets a permanent magnet (m̃ = m) or
-// saturated iron. Summed over falling_magnet it is about 0.2 N·m at ×1 and 1 N·m at ×3 (issue
-// #12): at ×3 with 40 QuickStep iterations the magnet and its heap rolled off across the
+// saturated iron. Summed over falling_magnet it is about 0.2 N·m at ×1 and 1 N·m at ×3: at
+// ×3 with 40 QuickStep iterations the magnet and its heap rolled off across the
 // floor (0.65 m in 2 s) while the magnetic work kept growing. The correction takes the least
 // forces that cancel L = −Σ ℓ_j, weighted by each body's share w_b = |Σ_{j∈b} ℓ_j| so that it
 // lands where the torque arises (mass weights over every body did worse: at ×3, 1.2 s, KE

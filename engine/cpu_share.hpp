@@ -1,5 +1,5 @@
 // engine/cpu_share.hpp — how many threads the magnetics should use on a machine that other
-// processes share (issue #13, "busy machines").
+// processes share ("busy machines").
 //
 // OpenMP's parallel regions end in barriers: when another process holds one of the cores,
 // a descheduled team member stalls every barrier by a scheduler slice, and two threads run

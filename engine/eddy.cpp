@@ -1,6 +1,6 @@
 // engine/eddy.cpp — stage 3b of a step: the eddy-current loss of conducting induced bodies
-// (SimOptions::eddy_conductivity). Not in the paper: a stated physical loss (issue #12,
-// item 5) that acts only where there is a field to move through, so a scene without
+// (SimOptions::eddy_conductivity). Not in the paper: a stated physical loss that
+// acts only where there is a field to move through, so a scene without
 // magnetism keeps its mechanics.
 //
 // Moment j (volume V_j, the sphere it stands for has radius a_j = (3 V_j / 4π)^{1/3}) carries

@@ -1,4 +1,4 @@
-// engine/frame_builder.hpp — Model + State → render::Frame (STYLE.md §4: the engine builds
+// engine/frame_builder.hpp — Model + State → render::Frame (the engine builds
 // an abstract scene, render/ draws it and knows nothing of physics).
 #pragma once
 

@@ -1,4 +1,4 @@
-// engine/limits.hpp — the magnitudes a scene may hold (issue #13). Beyond them ODE's
+// engine/limits.hpp — the magnitudes a scene may hold. Beyond them ODE's
 // arithmetic overflows on the first step (1e300 m/s or m/s², an offset of 1e300 m, mass
 // 1e-300 kg: inf/NaN velocities, dxNormalize4's assertion) or the magnetics do (Ms or a
 // moment of 1e300). They are far outside anything physical at magsim's scales (mm–m

@@ -1,4 +1,4 @@
-// engine/model.hpp — the read-only Model compiled from a SceneDesc (STYLE.md §1).
+// engine/model.hpp — the read-only Model compiled from a SceneDesc.
 //
 // compile_model() validates the description (std::invalid_argument naming the body and the
 // field) and lays it out as structure-of-arrays, MuJoCo style: per-body mass properties,

@@ -317,7 +317,7 @@ struct OdeBridge::Impl {
   // whose half extents all grow by μ reaches μ Σ_i |n·a_i| (a_i its axes), up to √3 μ along a
   // corner's diagonal; a cylinder, whose radius and half length grow, μ (|n·z| + √(1−(n·z)²)).
   // Subtracting μ alone there read a box corner lying a gap away as penetrating by up to
-  // (√3 − 1) μ, and the error reduction pushed it out against the magnet (issue #12).
+  // (√3 − 1) μ, and the error reduction pushed it out against the magnet.
   double margin_along(int s, const dVector3 n) const {
     const double mu = shape_margin[s];
     if (mu == 0.0 || s == model.nshape) return mu;  // not grown; the ground plane

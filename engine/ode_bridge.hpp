@@ -1,4 +1,4 @@
-// engine/ode_bridge.hpp — the engine's only door to ODE (STYLE.md §3). No ODE type leaks
+// engine/ode_bridge.hpp — the engine's only door to ODE. No ODE type leaks
 // out of this header: the world, space, bodies, geoms and contact group live behind a pimpl.
 //
 // ODE is treated as a pure function of State: each step the bridge writes every body's pose

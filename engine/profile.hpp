@@ -1,4 +1,4 @@
-// engine/profile.hpp — what one rigid step cost, stage by stage (STYLE.md §7).
+// engine/profile.hpp — what one rigid step cost, stage by stage.
 //
 // T_i, T_f and T_r are the paper's Table 1 columns: magnetization dynamics, magnetic forces,
 // rigid-body collide + step. The finer fields split T_r and account for the engine's own

@@ -1,4 +1,4 @@
-// engine/scene_desc.hpp — a scene as plain data (STYLE.md §1): bodies, shapes, moments,
+// engine/scene_desc.hpp — a scene as plain data: bodies, shapes, moments,
 // materials and run options, defaults in-class, SI units in comments. A SceneDesc compiles
 // into a read-only Model; everything that changes lives in State.
 #pragma once
@@ -142,9 +142,10 @@ struct SimOptions {
   /// reaction_symmetric_forces; no effect on the classic and zeeman-total forces, which leave
   /// none). Those forces sum to zero, but not their torques (apply_forces.cpp): in
   /// falling_magnet about 0.2 N·m at ×1 and 1 N·m at ×3, where, with 40 QuickStep iterations,
-  /// it rolls the magnet and its heap off across the floor (issue #12). The correction is the
+  /// it rolls the magnet and its heap off across the floor. The correction is the
   /// least one that cancels it. Off in every registry scene: at ×1, over eight runs, it
-  /// changes neither the balls thrown at the landing nor the control's rest (README).
+  /// changes neither the balls thrown at the landing nor the control's rest
+  /// (tools/findings/falling_magnet.md).
   bool balance_magnetic_torque = false;
   /// The force on induced moments (method = the method's own pairing, the default).
   ForceChoice force_model = ForceChoice::Method;
@@ -256,7 +257,7 @@ inline bool force_conservative(const SimOptions& o) {
 struct SceneDesc {
   std::string name;
   std::string description;      ///< one line: what the scene shows
-  std::string modelling_level;  ///< DESIGN §2: what is simplified (moments per body, shapes…)
+  std::string modelling_level;  ///< what is simplified (moments per body, shapes…)
   std::vector<BodyDesc> bodies;
   Vec3 H0 = Vec3::Zero();       ///< uniform external field (A/m)
   SimOptions options;

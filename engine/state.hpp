@@ -1,4 +1,4 @@
-// engine/state.hpp — everything that changes during a run (STYLE.md §1): body poses and
+// engine/state.hpp — everything that changes during a run: body poses and
 // velocities, sub-magnetizations, the step counter. Plain data: copy it to save, assign it
 // back to restore, hash it to compare runs bit for bit.
 #pragma once

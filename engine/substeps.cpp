@@ -6,7 +6,7 @@
 // something in the last frame; a ball in free flight moves ballistically whatever the step,
 // and one ball thrown off at 8 m/s would otherwise split every frame of the whole scene for
 // as long as it flies (falling_magnet, ≤ 8 sub-steps, 6.5 per frame on average over 0.6 s
-// counting every body, 2.2 counting those in contact; issue #12):
+// counting every body, 2.2 counting those in contact):
 //  - motion, over the bodies that touched another body (not only the ground plane: see
 //    choose_substeps): the velocity the body had and its change over the last frame
 //    (contact forces included), (|v| + |Δv|) h ≤ reach · r_min;
@@ -16,8 +16,8 @@
 //    contacts in a sub-step of h; the error reduction then pushes it out against the magnet,
 //    which pulls it back in at about a h √(2ε). In alphabets (letters pressed onto the
 //    collider at ~10⁵ m/s²) the contacts' largest pushes, up to 12.6 J of work in a frame,
-//    came right after frames of a single sub-step (25 letters, each step traced; issue
-//    #12). Scenes whose piles rest under such loads split every frame: alphabets 13
+//    came right after frames of a single sub-step (25 letters, each step traced).
+//    Scenes whose piles rest under such loads split every frame: alphabets 13
 //    sub-steps per frame, and the magnetization, re-solved per sub-step from a nearer
 //    start, converges where it hit its cap before (35 frames of 2000 instead of 1531).
 #include "engine/stages.hpp"

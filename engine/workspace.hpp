@@ -1,4 +1,4 @@
-// engine/workspace.hpp — per-step scratch (STYLE.md §1): fields, forces, the next state.
+// engine/workspace.hpp — per-step scratch: fields, forces, the next state.
 // Sized once; a warm step allocates nothing.
 #pragma once
 

@@ -1,5 +1,5 @@
 // magnetics/anderson.hpp — the fourth method (beyond the paper): solve the self-consistent
-// magnetization M = f(H(M)) (DESIGN §1.4, eq. 10 curve) directly, by Picard iteration
+// magnetization M = f(H(M)) (eq. 10 curve, magnetics/PHYSICS.md) directly, by Picard iteration
 // M ← f(H(M)) accelerated with Anderson mixing. Each iteration costs one field evaluation,
 // like one Jacobi sweep of the dynamics, so iteration counts compare one to one.
 #pragma once

@@ -61,7 +61,7 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// magnetization. eq. 4's per-moment force is the part of this gradient where the sources
 /// stay fixed; what it leaves out (the neighbours' energies and magnetizations) makes it
 /// non-conservative in a pile: measured in falling_magnet, eq. 4 does 2.7× the work of the
-/// energy it releases (issue #12). The gradient, by the adjoint method:
+/// energy it releases (tools/findings/energy.md). The gradient, by the adjoint method:
 ///   m̃_i = V_i [A_i (2M_i + H_i) + M_i]                       (−∂e_i/∂H_i / μ0)
 ///   λ̃ = m̃ + V A T λ̃   (T: the dipole field of moments at induced moments, eq. 1)
 ///   F_k = μ0 [J_kᵀ λ̃_k + J̃_kᵀ m_k]          (k induced; J̃ = ∂H̃/∂p, H̃ the field of λ̃)

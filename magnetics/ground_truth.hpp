@@ -1,4 +1,4 @@
-// magnetics/ground_truth.hpp — the self-consistent magnetization M = f(H(M)) (DESIGN §1.4).
+// magnetics/ground_truth.hpp — the self-consistent magnetization M = f(H(M)) (magnetics/PHYSICS.md).
 #pragma once
 
 #include <functional>

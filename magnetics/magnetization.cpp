@@ -79,7 +79,7 @@ Vec3 effective_field(Method method, const DynamicsOptions& opt, const Vec3& H, c
     // so the fixed point H_eff = 0 ⇔ M = f(H) is kept exactly
     const double h = H.norm() / Ms;
     const double g_sol = h > 1e-4 ? h / std::tanh(3.0 * h) : (1.0 + 3.0 * h * h) / 3.0;
-    // measured stability limit of the raised bound: k·γ ≤ 2, k = β Δt Ms (DESIGN §6)
+    // measured stability limit of the raised bound: k·γ ≤ 2, k = β Δt Ms (magnetics/PHYSICS.md)
     const double cap = std::min(opt.adaptive_gamma_cap, 2.0 / (opt.beta * opt.dt * Ms));
     if (g_sol <= cap) bound = std::max(bound, g_sol);
   }
@@ -136,7 +136,7 @@ void rotate_toward(const Vec3& h_hat, double c_dt, double Ms, ThetaIntegrator in
   *Mk = Ms * (std::cos(th) * h_hat + std::sin(th) * e);
 }
 
-// LLG (eq. 6) explicit step with γ scaled so that γα Ms/(1+α²) = β (DESIGN §1.5):
+// LLG (eq. 6) explicit step with γ scaled so that γα Ms/(1+α²) = β (magnetics/PHYSICS.md):
 //   dM/dt = −(β/Ms) [ (1/α) M × H_eff + M × (M × H_eff) ],  then |M| ← Ms.
 // Damping-only LLG drops the precession term.
 void llg_step(bool precession, const DynamicsOptions& opt, double Ms, const Vec3& Heff,
@@ -149,7 +149,7 @@ void llg_step(bool precession, const DynamicsOptions& opt, double Ms, const Vec3
   if (n > 0) *Mk *= Ms / n;
 }
 
-// Keeps the half-angle between M1 and M2 at least φ_min (no collapse, DESIGN §6).
+// Keeps the half-angle between M1 and M2 at least φ_min (no collapse: once together they would stay so).
 void keep_pair_apart(double Ms, double phi_min, Vec3* M1, Vec3* M2) {
   const Vec3 d = *M1 - *M2;
   const double dn = d.norm();

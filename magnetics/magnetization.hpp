@@ -1,4 +1,4 @@
-// magnetics/magnetization.hpp — magnetization dynamics (paper §3.2–3.3, DESIGN §1.5).
+// magnetics/magnetization.hpp — magnetization dynamics (paper §3.2–3.3, magnetics/PHYSICS.md).
 #pragma once
 
 #include "magnetics/dipole_field.hpp"
@@ -17,7 +17,7 @@ enum class ThetaIntegrator : std::uint8_t {
 struct DynamicsOptions {
   Method method = Method::Ours;
   double dt = 100e-9;          ///< Δt_m, magnetization clock step (s); allowed [1 ns, 1 µs]
-  double beta = 5.0;           ///< β of eq. 8 (m·A⁻¹·s⁻¹); 0.005 per (ns·MA/m), DESIGN §1.5
+  double beta = 5.0;           ///< β of eq. 8 (m·A⁻¹·s⁻¹); 0.005 per (ns·MA/m), our reading of the unit
   double alpha = 0.2;          ///< LLG damping constant α of eq. 6 (Kim 2018: 0.2–0.25)
   double gamma_c_max = 1.0;    ///< upper bound of γ_C in eq. 11 (engages at |M| ≳ 0.995 Ms)
   /// Raise the bound to γ_C's value at the solution, |H|/|f(H)|, where that is larger: the
@@ -31,12 +31,12 @@ struct DynamicsOptions {
   /// What tol bounds. Residual (default): max_j |M_j − f(H_j)|/Ms_j of the iterate the
   /// sweep's fields came from — free, since H is computed anyway, and it does not stop a
   /// slow method early the way a small per-sweep change does. Change: max_j |ΔM_j|/Ms_j over
-  /// one sweep (DESIGN §1.7's wording).
+  /// one sweep (magnetics/PHYSICS.md's wording).
   enum class Criterion : std::uint8_t { Residual, Change } criterion = Criterion::Residual;
   int max_iter = 999;          ///< iteration cap per solve
   /// Floor (rad) of the half-angle between M_j1 and M_j2: a pair closer than this is spread
   /// back to it about M (|M| changes by < φ²/2 = 5e-13 relative), so the two
-  /// sub-magnetizations can never collapse onto each other (DESIGN §6).
+  /// sub-magnetizations can never collapse onto each other.
   double min_pair_angle = 1e-6;
   ThetaIntegrator theta_integrator = ThetaIntegrator::Exact;
   /// Method::Anderson: how many past residuals the least-squares mixing uses (0 = plain
@@ -142,7 +142,7 @@ Vec3 effective_field(Method method, const DynamicsOptions& opt, const Vec3& H, c
                      double Ms);
 
 /// Re-aligns the sub-pair about M (M unchanged) so that the pair axis is perpendicular to
-/// the part of H_eff transverse to M (DESIGN §6, "ours-realigned").
+/// the part of H_eff transverse to M ("ours-realigned", magnetics/PHYSICS.md).
 void realign_pair(const Vec3& Heff, double Ms, Vec3* M1, Vec3* M2);
 
 }  // namespace magsim::mag

@@ -2,7 +2,7 @@
 //
 // A moment j sits at world position p_j and stands for a volume V_j of material. It is
 // either induced (magnetization M_j computed from the field, saturation Ms_j, carried as two
-// sub-magnetizations M_j1, M_j2 with |M_jk| = Ms_j and M_j = (M_j1 + M_j2)/2, DESIGN §1.5)
+// sub-magnetizations M_j1, M_j2 with |M_jk| = Ms_j and M_j = (M_j1 + M_j2)/2, magnetics/PHYSICS.md)
 // or permanent (a fixed world-frame moment m_j, A·m²). Moments with the same group id
 // (≥ 0, usually a rigid body) exert no force on each other, but still magnetize each other.
 #pragma once

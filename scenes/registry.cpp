@@ -1,4 +1,4 @@
-// scenes/registry.cpp — the five scenes of DESIGN §3 as data. Sizes and strengths are ours
+// scenes/registry.cpp — the five scenes as data (the paper's four and crystal_balls). Sizes and strengths are ours
 // (the paper gives only counts); each is stated beside its value, in SI units.
 #include "scenes/registry.hpp"
 

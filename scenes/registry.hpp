@@ -1,4 +1,4 @@
-// scenes/registry.hpp — the one table of scenes (STYLE.md §5), shared by the scene binary,
+// scenes/registry.hpp — the one table of scenes, shared by the scene binary,
 // the tests and the benchmarks.
 #pragma once
 
@@ -21,7 +21,7 @@ struct SceneEntry {
   engine::SceneDesc (*build)(const SceneParams&);
 };
 
-/// balls_up, alphabets, falling_magnet, sakura_tree, crystal_balls (DESIGN §3).
+/// balls_up, alphabets, falling_magnet, sakura_tree, crystal_balls (the paper's §5 and ours).
 const std::vector<SceneEntry>& registry();
 /// nullptr when unknown.
 const SceneEntry* find_scene(const std::string& name);

@@ -174,7 +174,7 @@ def main():
     L.append("# magsim experiment report\n")
     L.append(f"Generated {datetime.datetime.now():%Y-%m-%d %H:%M} by `bash tools/report.sh`, "
              f"commit {commit}, on {os.cpu_count()} cores ({cpu}). Paper: *Fast Stabilization "
-             "of Inducible Magnet Simulation* (`../shared/paper.md`). Timings are medians of "
+             "of Inducible Magnet Simulation*. Timings are medians of "
              "one run on a shared machine; ratios are measured within the same run.\n")
 
     b = load(out, "bench.json")
@@ -206,7 +206,7 @@ def main():
             L.append("### Scaling (sakura_tree with N balls)\n")
             L.append(f"Medians over {b.get('scaling_window_steps', '?')} steps after "
                      f"{b.get('scaling_warmup_steps', '?')} warm-up steps (balls on the tree from "
-                     "t ≈ 0.28 s); issue #7's target: 10,000 balls at ≤ 50 ms per step.\n")
+                     "t ≈ 0.28 s); the target: 10,000 balls at ≤ 50 ms per step.\n")
             L.append("| balls | method | field solver | total ms/step | T_i | T_f | T_r | iterations |")
             L.append("|---|---|---|---|---|---|---|---|")
             for r in b["scaling"]:

@@ -1,4 +1,4 @@
-// tests/engine/cpu_share_test.cpp — the busy-machine thread count (issue #13).
+// tests/engine/cpu_share_test.cpp — the busy-machine thread count.
 #include "engine/cpu_share.hpp"
 #include "engine/simulation.hpp"
 #include "fixtures.hpp"

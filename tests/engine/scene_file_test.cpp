@@ -165,7 +165,7 @@ TEST_CASE("scene_file: the field solver options are read and checked", "[scene_f
   CHECK_THAT(error_of(R"({"options": {"bh_threshold": 2.5}, "bodies": []})"), Contains("options.bh_threshold: must be an integer"));
 }
 
-TEST_CASE("scene_file: a key given twice is an error naming the key and its path (#13)", "[scene_file][reliability]") {
+TEST_CASE("scene_file: a key given twice is an error naming the key and its path", "[scene_file][reliability]") {
   CHECK_THAT(error_of(R"({"bodies": [{"name": "b", "shapes": [{"kind": "sphere", "size": 0.005, "size": 0.01}]}]})"),
              Contains("scene.json: bodies[0].shapes[0].size: duplicate key"));
   CHECK_THAT(error_of(R"({"bodies": [], "bodies": []})"), Contains("scene.json: bodies: duplicate key"));
@@ -175,12 +175,12 @@ TEST_CASE("scene_file: a key given twice is an error naming the key and its path
   CHECK(error_of(R"({"bodies": [{"name": "a", "type": "static"}, {"name": "b", "type": "static"}]})").empty());
 }
 
-TEST_CASE("scene_file: a permanent moment needs \"moment\" (#13)", "[scene_file][reliability]") {
+TEST_CASE("scene_file: a permanent moment needs \"moment\"", "[scene_file][reliability]") {
   CHECK_THAT(error_of(R"({"bodies": [{"type": "static", "moments": [{"permanent": true, "volume": 1e-6}]}]})"),
              Contains("bodies[0].moments[0].moment: required for a permanent moment"));
 }
 
-TEST_CASE("scene_file: a scene name that is not a plain folder name is refused (#13)", "[scene_file][reliability]") {
+TEST_CASE("scene_file: a scene name that is not a plain folder name is refused", "[scene_file][reliability]") {
   for (const char* name : {R"("a/b")", R"("..")", R"("../up")", R"("tab\there")", R"("nl\n")", R"("")"})
     CHECK_THAT(error_of(std::string("{\"name\": ") + name + ", \"bodies\": []}"), Contains("scene.json: name: the scene name"));
   // invalid UTF-8 in the text: the JSON parser refuses it

@@ -37,7 +37,7 @@ TEST_CASE("step: a sphere dropped on the plane comes to rest at its radius", "[s
 
 TEST_CASE("step: an iron ball released near a fixed magnet moves toward it", "[step]") {
   SceneDesc s = weightless();
-  s.options.method = mag::Method::OursRealigned;  // converges in weak fields (DESIGN §6)
+  s.options.method = mag::Method::OursRealigned;  // converges in weak fields (magnetics/PHYSICS.md)
   s.bodies.push_back(cube_magnet(Vec3(0, 0, 0), Vec3(0, 0, 1.0)));
   s.bodies.push_back(iron_ball("ball", Vec3(0.001, 0, -0.03)));
   engine::Simulation sim(s);
@@ -120,7 +120,7 @@ TEST_CASE("step: every method runs and pulls a ball toward the magnet", "[step]"
     sim.run(20);
     CHECK(sim.body_position(1).z() > -0.03);
     CHECK(sim.last_profile().iterations >= 1);
-    // the literal dynamics converge slowly in weak fields (DESIGN §6): only the re-aligned
+    // the literal dynamics converge slowly in weak fields: only the re-aligned
     // one and the Newton solve are required to converge here
     if (method == mag::Method::OursRealigned || method == mag::Method::Exact)
       CHECK(sim.last_profile().converged);

@@ -39,7 +39,7 @@ Count count(MomentSet s, Method m, int cap, int depth = 5) {
 }
 
 // Two touching iron balls (radius 5 mm) along z in a weak field: |M| ≈ 0.025 Ms, where the
-// literal dynamics do not converge at all (DESIGN §6).
+// literal dynamics do not converge at all (magnetics/PHYSICS.md).
 MomentSet touching_spheres() {
   MomentSet s;
   const double a = magsim::test::kBallRadius;

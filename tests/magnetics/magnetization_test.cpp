@@ -95,7 +95,7 @@ TEST_CASE("moderate field: every method converges — realigned ours is the fast
   CHECK(it[0] < it[2]);  // ours < Kim 2018
 }
 
-TEST_CASE("weak field: only the re-aligned update converges fast (DESIGN §6 slow mode)",
+TEST_CASE("weak field: only the re-aligned update converges fast (the slow mode)",
           "[dynamics]") {
   // cluster(10): |M| ≤ 0.26 Ms. Measured: ours-realigned 65 sweeps; ours, Kim 2018 and
   // damping-only LLG still above e_M = 1e-3 after 999.

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """tests/tools/two_spheres_test.py — the exact two-sphere reference (tools/reference/
-two_spheres.py, issue #29) against what it must satisfy: two of the issue's values, the lone
+two_spheres.py) against what it must satisfy: two of the reference values, the lone
 sphere, the dipole-dipole far field, the mu = inf bispherical solution, the translation
 formula summed directly, the boundary conditions and the force as a Maxwell-stress
 integral. numpy only (no matplotlib); a few seconds. Run by CTest (label tools)."""
@@ -26,7 +26,7 @@ def rel(a, b):
 
 
 class IssueValues(unittest.TestCase):
-    # The issue gives 6 significant figures: 1e-5 relative is within its rounding.
+    # The reference values have 6 significant figures: 1e-5 relative is within their rounding.
     def test_axial_inf_gap_a(self):
         f, rows = ts.converged_force(INF, 1.0, "axial")
         self.assertLess(rel(f, -1.16473), 1e-5)
@@ -168,8 +168,8 @@ class MaxwellStress(unittest.TestCase):
 
 
 class DipoleModel(unittest.TestCase):
-    def test_ratios_of_the_issue(self):
-        # issue #29: axial x1.07 at g = a; transverse too strong by 4 % at g = a
+    def test_ratios_of_the_dipole_model(self):
+        # the dipole model: axial x1.07 at g = a; transverse too strong by 4 % at g = a
         f = ts.converged_force(INF, 1.0, "axial")[0]
         self.assertAlmostEqual(f / ts.dipole_model(INF, 1.0, "axial")[1], 1.07, delta=0.005)
         f = ts.converged_force(INF, 1.0, "transverse")[0]

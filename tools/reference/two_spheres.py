@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """tools/reference/two_spheres.py — exact linear magnetostatics of two identical spheres in a
-uniform field (issue #29, item 1): the reference that the one-dipole-per-ball model is held
+uniform field: the reference that the one-dipole-per-ball model is held
 against. Library and command line; numpy (Debian python3-numpy), matplotlib only for `chart`.
 
     /usr/bin/python3 tools/reference/two_spheres.py values
@@ -81,7 +81,7 @@ import numpy as np
 
 FIELDS = ("axial", "transverse")
 
-# The six values of issue #29 (mu0 H0^2 a^2): (field, mu, gap/a, value)
+# Six reference values (mu0 H0^2 a^2): (field, mu, gap/a, value)
 ISSUE_VALUES = [
     ("axial", math.inf, 1.0, -1.16473),
     ("axial", math.inf, 0.1, -17.5947),
@@ -410,18 +410,18 @@ def cmd_values(args):
         try:
             rows, sol = converge(mu, gap, field, L0=args.L0, rtol=args.rtol, L_max=args.L_max)
         except NotConverged as e:
-            print(f"{field}, mu = {fmt_mu(mu)}, g = {gap:g} a: issue {want:+.8g}")
+            print(f"{field}, mu = {fmt_mu(mu)}, g = {gap:g} a: reference {want:+.8g}")
             print_table(e.rows)
             print(f"    -> {e} [OFF]\n")
             worst = math.inf
             continue
         err = abs(sol.force - want) / abs(want)
         worst = max(worst, err)
-        print(f"{field}, mu = {fmt_mu(mu)}, g = {gap:g} a: issue {want:+.8g}")
+        print(f"{field}, mu = {fmt_mu(mu)}, g = {gap:g} a: reference {want:+.8g}")
         print_table(rows)
         ok = "ok" if err <= 1e-5 else "OFF"
         print(f"    -> {sol.force:+.10g} at L = {rows[-1][0]} (change below {args.rtol:g} from "
-              f"L = {rows[-2][0]}); relative error against the issue {err:.2e} [{ok}]\n")
+              f"L = {rows[-2][0]}); relative error against the reference {err:.2e} [{ok}]\n")
     print(f"worst relative error {worst:.2e} (tolerance 1e-5)")
     return 0 if worst <= 1e-5 else 1
 
@@ -519,10 +519,10 @@ def main(argv=None):
         sp.add_argument("--L-max", dest="L_max", type=int, default=3200,
                         help="give up past this order (default 3200)")
 
-    sv = sub.add_parser("values", help="the six values of issue #29 with convergence in L",
-                        description="Reproduces the six forces of issue #29, printing the force at "
+    sv = sub.add_parser("values", help="the six reference values with convergence in L",
+                        description="Reproduces the six reference forces, printing the force at "
                                     "L0, 2 L0, 4 L0 ... until it changes by less than --rtol; exits 1 "
-                                    "if any is off the issue's value by more than 1e-5 relative.")
+                                    "if any is off its reference value by more than 1e-5 relative.")
     conv_opts(sv)
     sf = sub.add_parser("force", help="one configuration",
                         description="Force on the upper sphere of one configuration, with the dipole "
