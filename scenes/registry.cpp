@@ -351,6 +351,10 @@ SceneDesc sakura_tree(const SceneParams& p) {
   // rolling resistance between two balls too (the same ρ): a ball hanging on one neighbour
   // at a tip rolls to and fro on it without loss otherwise
   s.options.rolling_friction_bodies = kRollingCoefficient * r;
+  // up to 8 rigid sub-steps per frame, by motion and by load: balls held at a tip are
+  // pressed into their contacts at ~10^4 m/s^2 (x1) to ~5·10^4 (x3), and with one step per
+  // frame the x3 pile blew up at QuickStep W 1.0 / 20 iterations (tools/findings/energy.md)
+  s.options.max_substeps = 8;
   s.camera.eye = Eigen::Vector3f(0.55f, -0.65f, 0.45f);
   s.camera.target = Eigen::Vector3f(0, 0, 0.17f);
   s.default_seconds = 2.0;
