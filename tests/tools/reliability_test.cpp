@@ -12,6 +12,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -863,4 +864,57 @@ TEST_CASE("magsim-scene: a second run into an output folder in use is refused, e
   CHECK(nlohmann::json::parse(text_of(out + "/summary.json"))["steps_requested"] == 100000);  // the first run's
   // the lock ends with the run that held it
   CHECK(scene("balls_up --count 5 --steps 1 --no-render --out " + out).code == 0);
+}
+
+// the PNG frames after a failed write: exit 3 (not 2), summary.json naming the error, and no
+// frame cut short under its name (render/png_io.cpp writes a temporary file and renames it)
+void check_png_write_failure(const std::string& out, const CommandResult& r, const char* why) {
+  INFO(r.out);
+  CHECK(r.code == 3);
+  CHECK(r.out.find("frame_000000.png") != std::string::npos);
+  CHECK(r.out.find(why) != std::string::npos);
+  std::ifstream f(out + "/summary.json");
+  REQUIRE(f.good());
+  const auto summary = nlohmann::json::parse(f);
+  CHECK(summary["error"].get<std::string>().find("writing frames") != std::string::npos);
+  CHECK(summary["error"].get<std::string>().find(why) != std::string::npos);
+  std::size_t frames = 0, temporaries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    frames += name.rfind("frame_", 0) == 0;
+    temporaries += name.rfind(".frame_", 0) == 0;
+    if (name.rfind("frame_", 0) == 0) {  // a frame left must be whole: its IEND chunk at the end
+      const std::string png = text_of(e.path().string());
+      CHECK(png.size() > 12);
+      CHECK(png.compare(png.size() - 8, 4, "IEND") == 0);
+    }
+  }
+  CHECK(frames == 0);  // the first frame failed
+  CHECK(temporaries == 0);
+}
+
+TEST_CASE("magsim-scene: a PNG frame that cannot be written is exit 3 with the error in summary.json, no truncated frame", "[reliability]") {
+  const std::string two_balls = std::string(MAGSIM_SOURCE_DIR) + "/scenes/examples/two_balls.json";
+  SECTION("a file size limit (ulimit -f): the 100 KB frame passes 50 KB, the 6 KB summary does not") {
+    const std::string out = tmp("png_fsize");
+    // 100 blocks of 512 bytes (dash); before: exit 2, no summary.json, a 51200-byte frame_000000.png
+    const CommandResult r = magsim::test::run_command(std::string("ulimit -f 100; ") + MAGSIM_SCENE_BIN,
+                                                      two_balls + " --steps 1 --threads 1 --out " + out);
+    if (r.out.find("built without the renderer") != std::string::npos) return;
+    check_png_write_failure(out, r, "File too large");
+  }
+  SECTION("a full disk: a 64 KiB tmpfs (needs root to mount: skipped elsewhere)") {
+    const std::string dir = tmp("png_full");
+    REQUIRE(std::system(("mkdir -p " + dir).c_str()) == 0);
+    if (std::system(("mount -t tmpfs -o size=64k tmpfs " + dir + " 2>/dev/null").c_str()) != 0) {
+      WARN("cannot mount a tmpfs here (not root?): the full-disk PNG case is skipped");
+      return;
+    }
+    struct Unmount {  // also when a REQUIRE ends the section
+      std::string dir;
+      ~Unmount() { std::system(("umount " + dir).c_str()); }
+    } unmount{dir};
+    const CommandResult r = scene(two_balls + " --steps 1 --threads 1 --out " + dir);
+    if (r.out.find("built without the renderer") == std::string::npos) check_png_write_failure(dir, r, "No space left on device");
+  }
 }
