@@ -68,11 +68,14 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   }
   if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
     throw UsageError("unknown method '" + a.method + "'");
+  // the thread cap holds for the flag and the scene file alike (--write-scene too)
+  const std::string cap = "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
+                          std::to_string(tools::max_threads() / 4) + " cores), got ";
   if (app.count("--threads")) {
-    if (a.threads > tools::max_threads())
-      throw UsageError("--threads: at most " + std::to_string(tools::max_threads()) + " (4 x the " +
-                       std::to_string(tools::max_threads() / 4) + " cores), got " + std::to_string(a.threads));
+    if (a.threads > tools::max_threads()) throw UsageError("--threads: " + cap + std::to_string(a.threads));
     s.options.threads = a.threads;
+  } else if (s.options.threads > tools::max_threads()) {
+    throw UsageError(a.scene + ": options.threads: " + cap + std::to_string(s.options.threads));
   }
   if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
   if (app.count("--tol")) s.options.magnetics.tol = a.tol;
@@ -173,15 +176,15 @@ int main(int argc, char** argv) {
   app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(tools::Range(16, 8192) & kEven)->capture_default_str();
   app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(tools::Range(1, 4))->capture_default_str();
   app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
-  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores")->check(tools::Range(1, 1000000000));
+  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores (0: sized to the free cores, the default)")->check(tools::OptionCheck("threads"));
   app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(tools::Range(1, 1000000000));
   app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(tools::PositiveNumber);
-  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7")->check(tools::PositiveNumber);
-  app.add_option("--tol", a.tol, "magnetization convergence tolerance")->check(tools::PositiveNumber);
-  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per step")->check(tools::Range(1, 1000000000));
+  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7, in [1e-9, 1e-6]")->check(tools::OptionCheck("magnetics.dt"));
+  app.add_option("--tol", a.tol, "magnetization convergence tolerance, in (0, 1)")->check(tools::OptionCheck("magnetics.tol"));
+  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per solve, in [1, 1000000]")->check(tools::OptionCheck("magnetics.max_iter"));
   app.add_option("--quickstep-iterations", a.quickstep_iterations,
                  "ODE QuickStep (contact solver) iterations per rigid step (default: the scene's, 20)")
-      ->check(tools::Range(1, 100000));
+      ->check(tools::OptionCheck("quickstep_iterations"));
   app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   app.add_option("--force-model", a.force_model,
@@ -195,20 +198,20 @@ int main(int argc, char** argv) {
                  "there, summary.json energy.guard says so)");
   app.add_option("--energy-guard-tolerance", a.energy_guard_tolerance,
                  "the guard's tolerance relative to the step's K_start + K_end + |U*_start| (default 1e-3)")
-      ->check(tools::NonNegativeNumber);
+      ->check(tools::OptionCheck("energy_guard_tolerance"));
   app.add_option("--energy-guard-floor", a.energy_guard_floor,
                  "the guard's absolute tolerance per step, J (default 1e-6)")
-      ->check(tools::NonNegativeNumber);
+      ->check(tools::OptionCheck("energy_guard_floor"));
   app.add_option("--energy-guard-max-substeps", a.energy_guard_max_substeps,
                  "most sub-steps the guard retakes a frame in (default 32)")
-      ->check(tools::Range(1, 64));
+      ->check(tools::OptionCheck("energy_guard_max_substeps"));
   app.add_option("--max-substeps", a.max_substeps,
                  "most rigid sub-steps per frame; a frame is split when bodies touching each other move fast or bodies "
                  "in contact are pressed hard by the magnetic force (1 = never; default: the scene's)")
-      ->check(tools::Range(1, 64));
+      ->check(tools::OptionCheck("max_substeps"));
   app.add_option("--substep-reach", a.substep_reach,
                  "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
-      ->check(tools::PositiveNumber);
+      ->check(tools::OptionCheck("substep_reach"));
   app.add_option("--substep-load", a.substep_load,
                  "on | off: also split a frame by the magnetic acceleration a of bodies in contact, "
                  "a h^2 <= reach * r_min per sub-step (default on)");
@@ -218,24 +221,24 @@ int main(int argc, char** argv) {
                  "reaction-symmetric forces (default: the scene's, off in every registry scene)");
   app.add_option("--rolling-friction", a.rolling_friction,
                  "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
-      ->check(tools::NonNegativeNumber);
+      ->check(tools::OptionCheck("rolling_friction"));
   app.add_option("--rolling-friction-bodies", a.rolling_friction_bodies,
                  "the same between two dynamic bodies (a ball rolling on a ball), rho (m) (0 = none; default: the scene's)")
-      ->check(tools::NonNegativeNumber);
+      ->check(tools::OptionCheck("rolling_friction_bodies"));
   app.add_option("--eddy-conductivity", a.eddy_conductivity,
                  "electrical conductivity sigma (S/m) of the induced bodies: eddy-current loss where their flux "
                  "density changes in their own frame (iron 1e7; 0 = none; default: the scene's)")
-      ->check(tools::NonNegativeNumber);
+      ->check(tools::OptionCheck("eddy_conductivity"));
   app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
-      ->check(tools::Range(1e-6, 1.999999));
-  app.add_option("--dt", a.dt, "rigid (frame) step dt_r in seconds, (0, 0.1] (default: the scene's, 1e-3)")
-      ->check(tools::Range(1e-7, 0.1));
+      ->check(tools::OptionCheck("quickstep_w"));
+  app.add_option("--dt", a.dt, "rigid (frame) step dt_r in seconds, in (0, 0.1] (default: the scene's, 1e-3)")
+      ->check(tools::OptionCheck("dt"));
   app.add_option("--bounded-pairs", a.bounded_pairs,
                  "on | off: evaluate a pair of moments no closer than the sum of their interaction radii (default: the scene's, off)");
   app.add_option("--softening", a.softening,
                  "dipole softening length eps (m): |r|^2 -> |r|^2 + eps^2 in every field, Jacobian and "
                  "force, in [0, 0.1] (default: the scene's)")
-      ->check(tools::Range(0.0, 0.1));
+      ->check(tools::OptionCheck("magnetics.softening"));
   a.field.add(&app,
               "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
