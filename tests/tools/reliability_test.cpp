@@ -1022,3 +1022,27 @@ TEST_CASE("--max-iter beyond its range is refused with the range, in flags and s
   CHECK(lines(m.out) == 1);
 }
 
+// ---- class 5: memory estimated up front ------------------------------------------------------
+
+TEST_CASE("magsim-scene: a --count whose scene will not fit in memory is refused at once, exit 1, one line", "[reliability]") {
+  // before: 1e8 balls climbed past 4 GB and ended in bad_alloc (exit 2)
+  const CommandResult r = magsim::test::run_command(kAddressLimit + "timeout 60 " + MAGSIM_SCENE_BIN,
+                                                    "balls_up --count 100000000 --steps 1 --no-render --out " + tmp("count_huge"));
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("balls_up --count 100000000: needs about") != std::string::npos);
+  CHECK(r.out.find("GB of memory") != std::string::npos);
+  CHECK(lines(r.out) == 1);
+  CHECK(!std::ifstream(tmp("count_huge") + "/summary.json").good());  // refused before the folder is touched
+  // --write-scene is refused the same way (it would build the scene)
+  CHECK(scene("balls_up --count 100000000 --write-scene " + tmp("count_huge.json")).code == 1);
+#if !defined(__SANITIZE_ADDRESS__)
+  // an address-space limit counts too: 500000 balls (about 5 GB) under 1.5 GB
+  const CommandResult v = magsim::test::run_command(kAddressLimit + MAGSIM_SCENE_BIN,
+                                                    "balls_up --count 500000 --steps 1 --no-render --out " + tmp("count_as"));
+  INFO(v.out);
+  CHECK(v.code == 1);
+  CHECK(v.out.find("the address-space limit") != std::string::npos);
+#endif
+}
+

@@ -5,14 +5,20 @@
 #include "scenes/scene_file.hpp"
 #include "tools/magsim_scene/magsim_scene.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <utility>
+
+#include <sys/resource.h>
 
 namespace magsim::scene_tool {
 
 namespace scenes = magsim::scenes;
+namespace fs = std::filesystem;
 
 std::string fmt(double x) {
   char b[32];
@@ -33,7 +39,72 @@ std::string registry_names() {
 }
 
 
+MemoryNeed memory_need(const engine::SceneDesc& s) {
+  MemoryNeed n;
+  n.bodies = static_cast<double>(s.bodies.size());
+  for (const engine::BodyDesc& b : s.bodies) {
+    n.moments += static_cast<double>(b.moments.size());
+    n.shapes += static_cast<double>(b.shapes.size());
+  }
+  return n;
+}
+
+double memory_available(std::string* source) {
+  double avail = -1;
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    while (std::fgets(line, sizeof line, f)) {
+      unsigned long long kb = 0;
+      if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
+        avail = static_cast<double>(kb) * 1024.0;
+        *source = "MemAvailable";
+        break;
+      }
+    }
+    std::fclose(f);
+  }
+  struct rlimit rl {};
+  if (::getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+    double mapped = 0;  // VmSize: what the address-space limit already counts
+    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      unsigned long long kb = 0;
+      while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "VmSize: %llu kB", &kb) == 1) mapped = static_cast<double>(kb) * 1024.0;
+      std::fclose(f);
+    }
+    const double left = std::max(0.0, static_cast<double>(rl.rlim_cur) - mapped);
+    if (avail < 0 || left < avail) {
+      avail = left;
+      *source = "the address-space limit (ulimit -v)";
+    }
+  }
+  return avail;
+}
+
+void check_memory(const std::string& what, const MemoryNeed& need) {
+  std::string source;
+  const double avail = memory_available(&source);
+  const double gb = 1e9;
+  char detail[256];
+  std::snprintf(detail, sizeof detail, "%.0f bodies, %.0f moments, %.0f shapes", need.bodies, need.moments, need.shapes);
+  if (need.steps > 0) std::snprintf(detail + std::strlen(detail), sizeof detail - std::strlen(detail), ", %.0f steps", need.steps);
+  if (avail >= 0 && need.bytes() > avail) {
+    char msg[512];
+    std::snprintf(msg, sizeof msg, "%s: needs about %.2f GB of memory (%s; estimated, magsim_scene.hpp MemoryNeed), "
+                  "more than the %.2f GB available (%s)", what.c_str(), need.bytes() / gb, detail, avail / gb, source.c_str());
+    throw UsageError(msg);
+  }
+  if (need.bodies >= kProgressBodies)
+    std::fprintf(stderr, "%s: %s; about %.2f GB of memory estimated%s\n", what.c_str(), detail, need.bytes() / gb,
+                 avail >= 0 ? (", " + fmt(avail / gb) + " GB available").c_str() : "");
+}
+
+
 namespace {
+
+// registry scenes above this --count are sized from builds of 1 and of this many first
+constexpr int kSampleCount = 100;
 
 // the value of an on | off flag
 bool on_off(const char* flag, const std::string& value) {
@@ -50,6 +121,10 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (ends_with(a.scene, ".json")) {
     if (app.count("--count")) throw UsageError("--count applies to registry scenes only, not to " + a.scene);
     try {
+      std::error_code ec;
+      const auto bytes = fs::file_size(a.scene, ec);
+      if (!ec && bytes >= (32u << 20))  // a large file takes seconds: say what is going on
+        std::fprintf(stderr, "%s: reading %.0f MB of scene file\n", a.scene.c_str(), static_cast<double>(bytes) / 1e6);
       s = scenes::load_scene_file(a.scene);
     } catch (const std::runtime_error& e) {
       throw UsageError(e.what());
@@ -64,6 +139,21 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     scenes::SceneParams p;
     if (app.count("--count")) p.count = a.count;
     if (app.count("--strength")) p.strength = a.strength;
+    if (p.count > kSampleCount) {
+      // the scene's own description would take memory in proportion to --count (1e8 balls:
+      // tens of GB before any check): its size is extrapolated from two small builds first
+      scenes::SceneParams small = p;
+      small.count = 1;
+      const MemoryNeed one = memory_need(e->build(small));
+      small.count = kSampleCount;
+      const MemoryNeed many = memory_need(e->build(small));
+      const double k = static_cast<double>(p.count - 1) / (kSampleCount - 1);
+      MemoryNeed need;
+      need.bodies = one.bodies + k * (many.bodies - one.bodies);
+      need.moments = one.moments + k * (many.moments - one.moments);
+      need.shapes = one.shapes + k * (many.shapes - one.shapes);
+      check_memory(a.scene + " --count " + std::to_string(p.count), need);
+    }
     s = e->build(p);
   }
   if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))

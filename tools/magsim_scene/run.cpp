@@ -90,12 +90,26 @@ int run(const Args& a, const CLI::App& app) {
   engine::ThreadGovernor governor(cores > 0 ? static_cast<int>(cores) : 1);  // Simulation caps it at its own count
   engine::SceneDesc scene = resolve_scene(a, app);
   const std::string method = mag::method_name(scene.options.method);
+  {
+    // the memory the run will take, refused up front when it will not fit (magsim_scene.hpp);
+    // the steps as below, bounded by kMaxSteps (a longer run is refused there)
+    MemoryNeed need = memory_need(scene);
+    const double secs = app.count("--seconds") ? a.seconds : scene.default_seconds;
+    need.steps = app.count("--steps") ? static_cast<double>(a.steps)
+                                      : std::min(kMaxSteps, std::max(1.0, secs / scene.options.dt));
+    need.frames = std::min(need.steps, need.steps * a.fps * scene.options.dt) + 2;
+    check_memory("scene '" + scene.name + "'", need);
+  }
   std::unique_ptr<engine::Simulation> sim_ptr;
+  const auto build_start = std::chrono::steady_clock::now();
   try {
     sim_ptr = std::make_unique<engine::Simulation>(scene);
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("scene '") + scene.name + "': " + e.what());
   }
+  if (static_cast<double>(scene.bodies.size()) >= kProgressBodies)
+    std::fprintf(stderr, "%s: %zu bodies built in %.1f s; stepping\n", scene.name.c_str(), scene.bodies.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count());
   engine::Simulation& sim = *sim_ptr;
   const engine::Model& model = sim.model();
   const bool adaptive = scene.options.threads == 0 && std::getenv("OMP_NUM_THREADS") == nullptr;
