@@ -1046,3 +1046,19 @@ TEST_CASE("magsim-scene: a --count whose scene will not fit in memory is refused
 #endif
 }
 
+// ---- class 4: parsing in linear time ------------------------------------------------------------
+
+TEST_CASE("scene files: the SAX parser keeps array indices and duplicate keys over 160,000 bodies", "[reliability]") {
+  // no timing check here (measured figures: issue #31's note); the parser that replaced the
+  // callback parser (quadratic in the body count) must still name the body of a duplicate key
+  const std::string file = tmp("many_bodies.json");
+  std::string text = "{\"bodies\": [";
+  for (int i = 0; i < 160000; ++i) text += "{\"position\": [0, 0, 1]},";
+  text += "{\"position\": [0, 0, 1], \"position\": [0, 0, 2]}]}";
+  write_text(file, text);
+  const CommandResult r = scene(file + " --steps 1 --no-render --out " + tmp("many_bodies"));
+  INFO(r.out.substr(0, 300));
+  CHECK(r.code == 1);
+  CHECK(r.out.find("bodies[160000].position: duplicate key") != std::string::npos);
+  CHECK(lines(r.out) == 1);
+}
