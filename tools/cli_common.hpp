@@ -174,7 +174,7 @@ inline CLI::Validator OptionCheck(const char* key) {
         const std::string bad = "must be " + r.what() + ", got '" + one_line(v) + "'";
         double x;
         if (r.integer) {
-          if (const std::string e = decimal_error(v); !e.empty()) return bad;
+          if (const std::string e = decimal_error(v); !e.empty()) return e + " in " + r.text() + ", got '" + one_line(v) + "'";
           errno = 0;
           const long long n = std::strtoll(v.c_str(), nullptr, 10);
           if (errno == ERANGE) return bad;

@@ -1002,7 +1002,7 @@ TEST_CASE("summary.json's options, pasted into a scene file, are accepted and re
   CHECK(second["state_hash"] == first["state_hash"]);
 }
 
-TEST_CASE("--max-iter beyond its range is refused with the range, in flags and scene files of both tools", "[reliability]") {
+TEST_CASE("both tools: a max_iter beyond its range is refused with the range, as a flag and in a scene file", "[reliability]") {
   // before: --method ours --max-iter 1000000000 ran one silent step of about 2.7 hours
   const CommandResult f = scene("balls_up --method ours --max-iter 1000000000 --steps 1 --no-render --out " + tmp("maxiter"));
   INFO(f.out);
