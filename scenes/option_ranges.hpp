@@ -44,11 +44,12 @@ struct OptionRange {
     const std::string t = text();
     return std::string(integer ? "an integer " : "a number ") + (t[0] == '(' || t[0] == '[' ? "in " : "") + t;
   }
-  /// "" when x is in the range, else "must be in (0, 1) (got 1.5)" (scene files' wording).
+  /// "" when x is in the range, else "must be in (0, 1) (got 1.5)" (scene files' wording; a
+  /// JSON value that is not an integer is refused before, as "must be an integer in ...").
   std::string error(double x) const {
     if (contains(x)) return {};
     const std::string t = text();
-    return std::string("must be ") + (integer ? "an integer " : "") + (t[0] == '(' || t[0] == '[' ? "in " : "") + t +
+    return std::string("must be ") + (t[0] == '(' || t[0] == '[' ? "in " : "") + t +
            " (got " + (integer && std::abs(x) < 1e18 ? std::to_string(static_cast<long long>(x)) : shortest(x)) + ")";
   }
   /// x in %g when that reads back as x, else in %.17g.
