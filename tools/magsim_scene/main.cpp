@@ -340,8 +340,10 @@ int main(int argc, char** argv) {
 
   app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
                                       "an output file could not be written",
-                                      "Runs longer than 1e7 rigid steps are refused; so are scene files that are not regular "
+                                      "Runs longer than 1e7 rigid steps are refused; so are runs whose estimated memory exceeds "
+                                      "MemAvailable or what ulimit -v leaves, scene files that are not regular "
                                       "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n"
+                                      "Every option flag has the range of its scene-file key (scenes/option_ranges.hpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
                                       "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
                                       "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
