@@ -1,7 +1,7 @@
 // scenes/option_ranges.hpp — one range per run option, shared by magsim-scene's flags
 // (tools/cli_common.hpp OptionCheck), magsolve's flags and the scene file's "options"
 // (scenes/options_json.cpp), so that what a flag accepts --write-scene can write and a scene
-// file read back, and summary.json's "options" rerun as a scene file (issue #31, class 10).
+// file read back, and summary.json's "options" rerun as a scene file.
 // Header-only: magsolve (magnetics only) uses it too.
 #pragma once
 

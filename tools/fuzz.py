@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """tools/fuzz.py — mutates the example scene files and magsolve cases and runs the tools on
-them, bounded in count and time (issue #13), with the hostile-input families of issue #31.
+them, bounded in count and time, with the hostile-input families.
 
     python3 tools/fuzz.py [--seconds 60] [--count 100000] [--seed 1] [--out out/fuzz]
                           [--bin build/release/tools]
@@ -13,7 +13,7 @@ magsolve's stdout not valid JSON or holding a non-finite number (JSON null). Aft
 case, every *.csv in its output folder must hold whole rows: each row the header's field
 count, the file ending with a line break.
 
-One case in four (from the fifth on) is one of the issue #31 families, in turn: a stop
+One case in four (from the fifth on) is one of the hostile-input families, in turn: a stop
 signal mid-run (SIGINT, SIGTERM, SIGHUP: exit 128 + signal, summary.json "interrupted");
 a closed pipe (magsolve: exit 3; magsim-scene: not killed); deep nesting (refused beyond 64
 levels); large --count (refused up front under a 1 GiB address-space limit); non-regular
@@ -203,7 +203,7 @@ def check_solve(path, timeout):
     return None
 
 
-# ---- issue #31's families ---------------------------------------------------------------------
+# ---- the hostile-input families -------------------------------------------------------------
 
 STOP_SIGNALS = [signal.SIGINT, signal.SIGTERM, signal.SIGHUP]
 AS_LIMIT = 1 << 30  # bytes of address space for the cases that must stay small
@@ -490,7 +490,7 @@ def main():
     while k < a.count and time.monotonic() - t0 < a.seconds:
         shutil.rmtree(run_dir, ignore_errors=True)
         case = os.path.join(a.out, "case.json")
-        if k >= 4 and k % 4 == 3:  # an issue #31 family, in turn
+        if k >= 4 and k % 4 == 3:  # a hostile-input family, in turn
             family = FAMILIES[(k // 4) % len(FAMILIES)]
             name = family.__name__[4:]
             per_family[name] += 1

@@ -1,4 +1,4 @@
-// tests/tools/reliability_test.cpp — issue #13 "never a crash, never a silent success":
+// tests/tools/reliability_test.cpp — "never a crash, never a silent success":
 // inputs that used to abort, segfault, run out of memory or exit 0 with nothing useful
 // done now end in a one-line error and the documented exit code (0 done, 1 bad input or
 // flags, 2 run failed, 3 I/O error).
@@ -182,7 +182,7 @@ TEST_CASE("magsim-scene: --threads above 4x the cores is a flag error naming the
 }
 
 TEST_CASE("magsolve: a case too big for the Newton reference is refused up front with the size", "[reliability]") {
-  // 20,000 induced moments: 3 matrices of 60,000² doubles = 80 GiB (bad_alloc before #13)
+  // 20,000 induced moments: 3 matrices of 60,000² doubles = 80 GiB (it was a bad_alloc once)
   const std::string path = tmp("huge.json");
   {
     std::ofstream f(path);
@@ -1049,7 +1049,7 @@ TEST_CASE("magsim-scene: a --count whose scene will not fit in memory is refused
 // ---- class 4: parsing in linear time ------------------------------------------------------------
 
 TEST_CASE("scene files: the SAX parser keeps array indices and duplicate keys over 160,000 bodies", "[reliability]") {
-  // no timing check here (measured figures: issue #31's note); the parser that replaced the
+  // no timing check here (timings are benchmarks' business); the parser that replaced the
   // callback parser (quadratic in the body count) must still name the body of a duplicate key
   const std::string file = tmp("many_bodies.json");
   std::string text = "{\"bodies\": [";

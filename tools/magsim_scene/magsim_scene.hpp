@@ -80,7 +80,7 @@ struct Args {
 };
 
 
-// ---- memory (issue #31, class 5) ----------------------------------------------------------
+// ---- memory ---------------------------------------------------------------------------------
 // A run's memory is estimated up front and refused (exit 1) when it will not fit, instead of
 // ending in bad_alloc after minutes. Measured peaks (Release, --steps 1 --no-render, RSS):
 // balls_up 6.6 KiB a body (1 shape, 1 moment), falling_magnet 7.8, sakura_tree and
