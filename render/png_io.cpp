@@ -12,6 +12,10 @@
 #include <cstdio>
 #include <cstring>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 namespace magsim::render {
 
 namespace {
@@ -22,7 +26,12 @@ struct PngErrorState {
 
 void png_error_fn(png_structp png, png_const_charp msg) {
   auto* st = static_cast<PngErrorState*>(png_get_error_ptr(png));
-  std::snprintf(st->message, sizeof st->message, "%s", msg ? msg : "unknown libpng error");
+  // libpng's "Write Error" comes from a failed fwrite: errno says why (a full disk, EFBIG)
+  const int err = errno;
+  if (err != 0)
+    std::snprintf(st->message, sizeof st->message, "%s (%s)", msg ? msg : "unknown libpng error", std::strerror(err));
+  else
+    std::snprintf(st->message, sizeof st->message, "%s", msg ? msg : "unknown libpng error");
   png_longjmp(png, 1);
 }
 
@@ -62,28 +71,74 @@ void set_error(std::string* error, const std::string& msg) {
   if (error) *error = msg;
 }
 
+// The process's umask without changing it (umask(2) can only be read by setting it, which
+// would race with other threads creating files): /proc/self/status "Umask:", else 022.
+mode_t current_umask() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  unsigned mask = 022;
+  if (f) {
+    char line[256];
+    while (std::fgets(line, sizeof line, f))
+      if (std::sscanf(line, "Umask: %o", &mask) == 1) break;
+    std::fclose(f);
+  }
+  return static_cast<mode_t>(mask & 0777);
+}
+
 }  // namespace
 
+// Written to a unique temporary file beside `path` (".NAME.XXXXXX") and renamed over it when
+// complete: a failed write (a full disk, a file size limit) removes the temporary file and
+// leaves no truncated PNG under the frame's name.
 bool write_png(const std::string& path, int w, int h, const std::uint8_t* rgb,
                std::string* error) {
   if (w <= 0 || h <= 0 || !rgb) {
     set_error(error, "write_png: empty image for " + path);
     return false;
   }
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) {
+  const std::size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+  std::string tmp = dir + "." + base + ".XXXXXX";
+  const int fd = ::mkstemp(tmp.data());
+  if (fd < 0) {
     set_error(error, "write_png: cannot open " + path + ": " + std::strerror(errno));
     return false;
   }
-  PngErrorState st{};
-  const char* msg = write_png_impl(f, w, h, rgb, &st);
-  const bool closed = std::fclose(f) == 0;
-  if (msg) {
-    set_error(error, "write_png: " + path + ": " + msg);
+  static const mode_t mask = current_umask();
+  if (::fchmod(fd, 0666 & ~mask) != 0) {  // mkstemp makes 0600; a frame is as fopen would make it
+    set_error(error, "write_png: cannot set the permissions of " + tmp + ": " + std::strerror(errno));
+    ::close(fd);
+    ::unlink(tmp.c_str());
     return false;
   }
-  if (!closed) {
-    set_error(error, "write_png: error closing " + path + ": " + std::strerror(errno));
+  std::FILE* f = ::fdopen(fd, "wb");
+  if (!f) {
+    set_error(error, "write_png: cannot open " + path + ": " + std::strerror(errno));
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    return false;
+  }
+  PngErrorState st{};
+  errno = 0;
+  const char* msg = write_png_impl(f, w, h, rgb, &st);
+  errno = 0;
+  const bool flushed = std::fflush(f) == 0 && !std::ferror(f);
+  const int flush_errno = errno;
+  const bool closed = std::fclose(f) == 0;
+  const int close_errno = errno;
+  if (msg || !flushed || !closed) {
+    ::unlink(tmp.c_str());
+    if (msg) set_error(error, "write_png: " + path + ": " + msg);
+    else
+      set_error(error, "write_png: error writing " + path + ": " +
+                           std::strerror(!flushed ? (flush_errno ? flush_errno : EIO) : (close_errno ? close_errno : EIO)));
+    return false;
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    set_error(error, "write_png: cannot rename " + tmp + " to " + path + ": " + std::strerror(err));
     return false;
   }
   return true;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "render/frame.hpp"
+#include "scenes/option_ranges.hpp"
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -78,6 +79,13 @@ class JsonReader {
     if (x < lo || x > hi)
       fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(x) + ")");
     return static_cast<int>(x);
+  }
+  /// A run option in its one range (scenes/option_ranges.hpp): the flags check the same.
+  double option(const nlohmann::json& j, const std::string& path, const OptionRange& range) const {
+    if (range.integer && !j.is_number_integer()) fail(path, "must be an integer in " + range.text());
+    const double x = number(j, path);
+    if (const std::string e = range.error(x); !e.empty()) fail(path, e);
+    return x;
   }
   bool boolean(const nlohmann::json& j, const std::string& path) const {
     if (!j.is_boolean()) fail(path, "must be true or false");

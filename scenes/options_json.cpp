@@ -4,6 +4,7 @@
 #include "scenes/options_json.hpp"
 
 #include "engine/limits.hpp"
+#include "scenes/option_ranges.hpp"
 #include "magnetics/magnetization.hpp"
 
 namespace magsim::scenes {
@@ -121,14 +122,14 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, mag:
   r.keys(j, path, {"dt", "beta", "alpha", "gamma_c_max", "adaptive_gamma_bound", "adaptive_gamma_cap",
                    "tol", "criterion", "max_iter", "min_pair_angle", "theta_integrator", "softening",
                    "bounded_pairs", "anderson_depth", "anderson_damping", "anderson_restart_growth"});
-  if_present(j, "dt", path, [&](const json& v, const std::string& p) { d->dt = r.in_range(v, p, 1e-9, 1e-6); });
+  if_present(j, "dt", path, [&](const json& v, const std::string& p) { d->dt = r.option(v, p, option_range("magnetics.dt")); });
   if_present(j, "beta", path, [&](const json& v, const std::string& p) { d->beta = r.positive(v, p); });
   if_present(j, "alpha", path, [&](const json& v, const std::string& p) { d->alpha = r.in_range(v, p, 1e-12, 1.0); });
   if_present(j, "gamma_c_max", path, [&](const json& v, const std::string& p) { d->gamma_c_max = r.in_range(v, p, 1.0 / 3.0, 1e12); });
   if_present(j, "adaptive_gamma_bound", path, [&](const json& v, const std::string& p) { d->adaptive_gamma_bound = r.boolean(v, p); });
   if_present(j, "adaptive_gamma_cap", path, [&](const json& v, const std::string& p) { d->adaptive_gamma_cap = r.positive(v, p); });
-  if_present(j, "tol", path, [&](const json& v, const std::string& p) { d->tol = r.in_range(v, p, 1e-300, 0.999999); });
-  if_present(j, "max_iter", path, [&](const json& v, const std::string& p) { d->max_iter = r.integer(v, p, 1, 100000000); });
+  if_present(j, "tol", path, [&](const json& v, const std::string& p) { d->tol = r.option(v, p, option_range("magnetics.tol")); });
+  if_present(j, "max_iter", path, [&](const json& v, const std::string& p) { d->max_iter = static_cast<int>(r.option(v, p, option_range("magnetics.max_iter"))); });
   if_present(j, "min_pair_angle", path, [&](const json& v, const std::string& p) { d->min_pair_angle = r.in_range(v, p, 1e-300, 0.0099999); });
   if_present(j, "theta_integrator", path, [&](const json& v, const std::string& p) {
     const std::string s = r.string(v, p);
@@ -142,7 +143,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, mag:
     else if (s == "change") d->criterion = mag::DynamicsOptions::Criterion::Change;
     else r.fail(p, "unknown criterion '" + s + "' (residual, change)");
   });
-  if_present(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.non_negative(v, p); });
+  if_present(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.option(v, p, option_range("magnetics.softening")); });
   if_present(j, "bounded_pairs", path, [&](const json& v, const std::string& p) { d->field.bounded_pairs = r.boolean(v, p); });
   if_present(j, "anderson_depth", path, [&](const json& v, const std::string& p) { d->anderson_depth = r.integer(v, p, 0, 50); });
   if_present(j, "anderson_damping", path, [&](const json& v, const std::string& p) { d->anderson_damping = r.in_range(v, p, 1e-300, 1.0); });
@@ -163,8 +164,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "energy_guard_floor", "energy_guard_max_substeps"});
   if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
   if_present(j, "dt", path, [&](const json& v, const std::string& p) {
-    o->dt = r.number(v, p);
-    if (!(o->dt > 0 && o->dt <= 0.1)) r.fail(p, "must be in (0, 0.1] s (got " + JsonReader::fmt(o->dt) + ")");
+    o->dt = r.option(v, p, option_range("dt"));
   });
   if_present(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.bounded(v, p, engine::limits::kMaxGravity, "m/s^2"); });
   if_present(j, "ground", path, [&](const json& v, const std::string& p) { o->ground = r.boolean(v, p); });
@@ -172,7 +172,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "restitution", path, [&](const json& v, const std::string& p) { o->restitution = r.in_range(v, p, 0, 1); });
   if_present(j, "erp", path, [&](const json& v, const std::string& p) { o->erp = r.in_range(v, p, 0, 1); });
   if_present(j, "cfm", path, [&](const json& v, const std::string& p) { o->cfm = r.non_negative(v, p); });
-  if_present(j, "quickstep_iterations", path, [&](const json& v, const std::string& p) { o->quickstep_iterations = r.integer(v, p, 1, 100000); });
+  if_present(j, "quickstep_iterations", path, [&](const json& v, const std::string& p) { o->quickstep_iterations = static_cast<int>(r.option(v, p, option_range("quickstep_iterations"))); });
   if_present(j, "max_contacts", path, [&](const json& v, const std::string& p) { o->max_contacts = r.integer(v, p, 1, 64); });
   if_present(j, "space", path, [&](const json& v, const std::string& p) { o->space = space_kind(r, v, p); });
   if_present(j, "auto_disable", path, [&](const json& v, const std::string& p) { o->auto_disable = r.boolean(v, p); });
@@ -181,26 +181,25 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "surface_layer", path, [&](const json& v, const std::string& p) { o->surface_layer = r.non_negative(v, p); });
   if_present(j, "max_correcting_velocity", path, [&](const json& v, const std::string& p) { o->max_correcting_velocity = r.non_negative(v, p); });
   if_present(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
-  if_present(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = r.integer(v, p, 0, 1024); });
+  if_present(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = static_cast<int>(r.option(v, p, option_range("threads"))); });
   if_present(j, "force_model", path, [&](const json& v, const std::string& p) {
     const std::string s = r.string(v, p);
     if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic, zeeman-total)");
   });
   if_present(j, "energy_guard", path, [&](const json& v, const std::string& p) { o->energy_guard = r.boolean(v, p); });
-  if_present(j, "energy_guard_tolerance", path, [&](const json& v, const std::string& p) { o->energy_guard_tolerance = r.non_negative(v, p); });
-  if_present(j, "energy_guard_floor", path, [&](const json& v, const std::string& p) { o->energy_guard_floor = r.non_negative(v, p); });
-  if_present(j, "energy_guard_max_substeps", path, [&](const json& v, const std::string& p) { o->energy_guard_max_substeps = r.integer(v, p, 1, 64); });
-  if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = r.integer(v, p, 1, 64); });
-  if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.positive(v, p); });
+  if_present(j, "energy_guard_tolerance", path, [&](const json& v, const std::string& p) { o->energy_guard_tolerance = r.option(v, p, option_range("energy_guard_tolerance")); });
+  if_present(j, "energy_guard_floor", path, [&](const json& v, const std::string& p) { o->energy_guard_floor = r.option(v, p, option_range("energy_guard_floor")); });
+  if_present(j, "energy_guard_max_substeps", path, [&](const json& v, const std::string& p) { o->energy_guard_max_substeps = static_cast<int>(r.option(v, p, option_range("energy_guard_max_substeps"))); });
+  if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = static_cast<int>(r.option(v, p, option_range("max_substeps"))); });
+  if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.option(v, p, option_range("substep_reach")); });
   if_present(j, "substep_load", path, [&](const json& v, const std::string& p) { o->substep_load = r.boolean(v, p); });
-  if_present(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.non_negative(v, p); });
+  if_present(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.option(v, p, option_range("rolling_friction")); });
   if_present(j, "rolling_friction_bodies", path,
-             [&](const json& v, const std::string& p) { o->rolling_friction_bodies = r.non_negative(v, p); });
+             [&](const json& v, const std::string& p) { o->rolling_friction_bodies = r.option(v, p, option_range("rolling_friction_bodies")); });
   if_present(j, "eddy_conductivity", path,
-             [&](const json& v, const std::string& p) { o->eddy_conductivity = r.non_negative(v, p); });
+             [&](const json& v, const std::string& p) { o->eddy_conductivity = r.option(v, p, option_range("eddy_conductivity")); });
   if_present(j, "quickstep_w", path, [&](const json& v, const std::string& p) {
-    o->quickstep_w = r.number(v, p);
-    if (!(o->quickstep_w > 0 && o->quickstep_w < 2)) r.fail(p, "must be in (0, 2) (got " + JsonReader::fmt(o->quickstep_w) + ")");
+    o->quickstep_w = r.option(v, p, option_range("quickstep_w"));
   });
   if_present(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
   if_present(j, "balance_magnetic_torque", path, [&](const json& v, const std::string& p) { o->balance_magnetic_torque = r.boolean(v, p); });
@@ -210,10 +209,9 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
     if (!mag::parse_field_solver(s, &f.solver)) r.fail(p, "unknown field solver '" + s + "' (direct, barnes-hut, auto)");
   });
   if_present(j, "bh_theta", path, [&](const json& v, const std::string& p) {
-    f.bh_theta = r.number(v, p);
-    if (!(f.bh_theta > 0 && f.bh_theta <= 1)) r.fail(p, "must be in (0, 1] (got " + JsonReader::fmt(f.bh_theta) + ")");
+    f.bh_theta = r.option(v, p, option_range("bh_theta"));
   });
-  if_present(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = r.integer(v, p, 0, 1000000000); });
+  if_present(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = static_cast<int>(r.option(v, p, option_range("bh_threshold"))); });
   if_present(j, "bh_leaf_size", path, [&](const json& v, const std::string& p) { f.bh_leaf_size = r.integer(v, p, 1, 1000000); });
   if_present(j, "bh_group_size", path, [&](const json& v, const std::string& p) { f.bh_group_size = r.integer(v, p, 1, 1000000); });
   if_present(j, "bh_order", path, [&](const json& v, const std::string& p) { f.bh_order = r.integer(v, p, 1, 2); });

@@ -4,6 +4,8 @@
 // --threads and OMP_NUM_THREADS alike, and the signal dispositions of both programs.
 #pragma once
 
+#include "scenes/option_ranges.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <cerrno>
@@ -161,6 +163,30 @@ CLI::Validator Range(T lo, T hi) {
         },
         range);
   }
+}
+
+/// The flag of a run option: its one range (scenes/option_ranges.hpp), the scene file's too.
+/// An integer option takes decimal digits only (decimal_error).
+inline CLI::Validator OptionCheck(const char* key) {
+  const scenes::OptionRange& r = scenes::option_range(key);
+  return CLI::Validator(
+      [r](std::string& v) -> std::string {
+        const std::string bad = "must be " + r.what() + ", got '" + one_line(v) + "'";
+        double x;
+        if (r.integer) {
+          if (const std::string e = decimal_error(v); !e.empty()) return e + " in " + r.text() + ", got '" + one_line(v) + "'";
+          errno = 0;
+          const long long n = std::strtoll(v.c_str(), nullptr, 10);
+          if (errno == ERANGE) return bad;
+          x = static_cast<double>(n);
+        } else {
+          char* end = nullptr;
+          x = std::strtod(v.c_str(), &end);
+          if (v.empty() || *end != '\0') return bad;
+        }
+        return r.contains(x) ? std::string() : "must be " + r.what() + ", got " + one_line(v);
+      },
+      r.text());
 }
 
 /// A number > 0 (CLI::PositiveNumber with a one-line message).

@@ -158,14 +158,14 @@ int run(int argc, char** argv) {
       ->required();
   app.add_option("--method", method_name, magsim::scenes::method_list("|"))->capture_default_str();
   app.add_option("--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6]")
-      ->capture_default_str();
-  app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration")
-      ->capture_default_str();
-  app.add_option("--max-iter", max_iter, "iteration cap")->check(magsim::tools::Decimal)->capture_default_str();
+      ->check(magsim::tools::OptionCheck("magnetics.dt"))->capture_default_str();
+  app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration, in (0, 1)")
+      ->check(magsim::tools::OptionCheck("magnetics.tol"))->capture_default_str();
+  app.add_option("--max-iter", max_iter, "iteration cap, in [1, 1000000]")->check(magsim::tools::OptionCheck("magnetics.max_iter"))->capture_default_str();
   app.add_option("--softening", softening,
                  "softening length ε in metres (0 = off; needed for two moments closer than half "
-                 "the sum of their radii, a = the radius of a sphere of the moment's volume)")
-      ->capture_default_str();
+                 "the sum of their radii, a = the radius of a sphere of the moment's volume), in [0, 0.1]")
+      ->check(magsim::tools::OptionCheck("magnetics.softening"))->capture_default_str();
   app.add_option("--residual-tol", residual_tol,
                  "\"converged\" needs the iteration to stop (--tol) and every induced moment's "
                  "|M - f(H)| <= this x max(|M|, |f(H)|)")

@@ -80,6 +80,36 @@ struct Args {
 };
 
 
+// ---- memory ---------------------------------------------------------------------------------
+// A run's memory is estimated up front and refused (exit 1) when it will not fit, instead of
+// ending in bad_alloc after minutes. Measured peaks (Release, --steps 1 --no-render, RSS):
+// balls_up 6.6 KiB a body (1 shape, 1 moment), falling_magnet 7.8, sakura_tree and
+// crystal_balls 3.7, alphabets 25 (letters of several shapes and 2.6 moments), over a base
+// of about 60 MB. The estimate below is above all of them (up to 2.7x for sakura_tree):
+// refusing a run that would have fit is the lesser harm.
+struct MemoryNeed {
+  double bodies = 0, moments = 0, shapes = 0;  // the scene's
+  double steps = 0, frames = 0;                 // the run's
+  /// bytes: base + per body, moment and shape (ODE bodies, geoms and contacts, the model,
+  /// state and magnetics workspace), per step (the timing series) and per recorded frame
+  /// (summary.json's series)
+  double bytes() const {
+    return 64.0 * (1 << 20) + 6144.0 * bodies + 2048.0 * (moments + shapes) + 80.0 * steps + 512.0 * frames;
+  }
+};
+/// The scene's bodies, moments and shapes.
+MemoryNeed memory_need(const engine::SceneDesc& s);
+/// Bytes this process may still take: /proc/meminfo's MemAvailable, and the address-space
+/// limit (RLIMIT_AS) less what is mapped now when it is lower; *source says which. < 0 when
+/// neither can be read (then nothing is refused).
+double memory_available(std::string* source);
+/// Throws UsageError "<what>: needs about X GB of memory (...), more than the Y GB available
+/// (...)" when need.bytes() exceeds memory_available(); prints a progress line for large
+/// scenes (from kProgressBodies bodies) with the estimate.
+void check_memory(const std::string& what, const MemoryNeed& need);
+/// From this many bodies magsim-scene says what it is doing while it reads and builds.
+constexpr double kProgressBodies = 20000;
+
 std::string fmt(double x);
 bool ends_with(const std::string& s, const std::string& tail);
 /// "balls_up, alphabets, …"

@@ -15,6 +15,10 @@ bool is_output_name(const std::string& f) {
     if (f == n) return true;
   // summary.json's temporary file (tools/replace_file.hpp), left by a killed run
   if (f.size() == 20 && f.compare(0, 14, ".summary.json.") == 0) return true;
+  // a frame's temporary file (render/png_io.cpp), left by a killed run: .frame_%06d.png.XXXXXX
+  if (f.size() > 8 && f[0] == '.' && f.compare(f.size() - 7, 1, ".") == 0 && is_output_name(f.substr(1, f.size() - 8)) &&
+      f.compare(1, 6, "frame_") == 0)
+    return true;
   // frame_%06d.png (six or more digits)
   const std::size_t digits = f.size() >= 10 ? f.size() - 10 : 0;
   if (f.size() < 16 || f.compare(0, 6, "frame_") != 0 || f.compare(f.size() - 4, 4, ".png") != 0) return false;

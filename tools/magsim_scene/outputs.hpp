@@ -197,13 +197,17 @@ class FrameRenderer {
     const auto t0 = std::chrono::steady_clock::now();
     renderer_->draw(sim.frame(opts_));
     ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    writer_->push(magsim::render::frame_path(dir_, index_++), renderer_->width(), renderer_->height(),
-                  renderer_->pixels());
+    try {
+      writer_->push(magsim::render::frame_path(dir_, index_++), renderer_->width(), renderer_->height(),
+                    renderer_->pixels());
+    } catch (const std::runtime_error& e) {  // an earlier frame could not be written: an I/O error
+      throw IoError(std::string("writing frames: ") + e.what());
+    }
 #else
     (void)sim;
 #endif
   }
-  /// Waits for the PNG writer; throws its first error.
+  /// Waits for the PNG writer; throws its first error (a frame that could not be written).
   void finish() {
 #ifdef MAGSIM_HAVE_RENDER
     if (writer_) writer_->finish();

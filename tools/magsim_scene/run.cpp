@@ -18,12 +18,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cinttypes>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -80,6 +82,59 @@ const char* signal_name(int sig) {
   return "a signal";
 }
 
+// A step of a large scene can take minutes (10^6 balls: the first one longer than the build):
+// for scenes from kProgressBodies bodies a watcher thread says every 10 s that the step is
+// still running, so a long run is never silent. Smaller scenes start no thread and pay
+// nothing per step.
+class SlowStepNotice {
+ public:
+  SlowStepNotice(bool on, std::string what) : on_(on), what_(std::move(what)) {
+    if (on_) thread_ = std::thread([this] { watch(); });
+  }
+  ~SlowStepNotice() {
+    if (!on_) return;
+    {
+      std::lock_guard<std::mutex> l(m_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  SlowStepNotice(const SlowStepNotice&) = delete;
+  SlowStepNotice& operator=(const SlowStepNotice&) = delete;
+  void begin(long step) {
+    if (!on_) return;
+    std::lock_guard<std::mutex> l(m_);
+    step_ = step;
+    start_ = std::chrono::steady_clock::now();
+  }
+  void end() {
+    if (!on_) return;
+    std::lock_guard<std::mutex> l(m_);
+    step_ = -1;
+  }
+
+ private:
+  void watch() {
+    std::unique_lock<std::mutex> l(m_);
+    while (!done_) {
+      cv_.wait_for(l, std::chrono::seconds(10));
+      if (done_ || step_ < 0) continue;
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      if (s >= 10) std::fprintf(stderr, "%s: step %ld still running after %.0f s\n", what_.c_str(), step_, s);
+    }
+  }
+
+  bool on_;
+  std::string what_;
+  std::thread thread_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  long step_ = -1;
+  std::chrono::steady_clock::time_point start_;
+};
+
 }  // namespace
 
 int run(const Args& a, const CLI::App& app) {
@@ -90,12 +145,26 @@ int run(const Args& a, const CLI::App& app) {
   engine::ThreadGovernor governor(cores > 0 ? static_cast<int>(cores) : 1);  // Simulation caps it at its own count
   engine::SceneDesc scene = resolve_scene(a, app);
   const std::string method = mag::method_name(scene.options.method);
+  {
+    // the memory the run will take, refused up front when it will not fit (magsim_scene.hpp);
+    // the steps as below, bounded by kMaxSteps (a longer run is refused there)
+    MemoryNeed need = memory_need(scene);
+    const double secs = app.count("--seconds") ? a.seconds : scene.default_seconds;
+    need.steps = app.count("--steps") ? static_cast<double>(a.steps)
+                                      : std::min(kMaxSteps, std::max(1.0, secs / scene.options.dt));
+    need.frames = std::min(need.steps, need.steps * a.fps * scene.options.dt) + 2;
+    check_memory("scene '" + scene.name + "'", need);
+  }
   std::unique_ptr<engine::Simulation> sim_ptr;
+  const auto build_start = std::chrono::steady_clock::now();
   try {
     sim_ptr = std::make_unique<engine::Simulation>(scene);
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("scene '") + scene.name + "': " + e.what());
   }
+  if (static_cast<double>(scene.bodies.size()) >= kProgressBodies)
+    std::fprintf(stderr, "%s: %zu bodies built in %.1f s; stepping\n", scene.name.c_str(), scene.bodies.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count());
   engine::Simulation& sim = *sim_ptr;
   const engine::Model& model = sim.model();
   const bool adaptive = scene.options.threads == 0 && std::getenv("OMP_NUM_THREADS") == nullptr;
@@ -153,6 +222,7 @@ int run(const Args& a, const CLI::App& app) {
   const auto t0 = clock::now();
   auto last_report = t0;
   std::string io_error;  // the first failed write; the run stops there
+  SlowStepNotice notice(static_cast<double>(scene.bodies.size()) >= kProgressBodies, scene.name + " " + method);
   try {
     if (rec.frame()) painter.draw(sim);
     for (long k = 0; k < n_steps; ++k) {
@@ -160,8 +230,11 @@ int run(const Args& a, const CLI::App& app) {
       if (adaptive) sim.limit_default_threads(governor.threads());
       threads.push_back(sim.threads());
       try {
+        notice.begin(sim.steps() + 1);
         sim.step();
+        notice.end();
       } catch (const engine::SimulationError& e) {
+        notice.end();
         error = e.what();
         break;
       }
