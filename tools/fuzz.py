@@ -223,13 +223,22 @@ def finish(p, timeout):
         return None
 
 
+def default_stop_signals():
+    """In the child: the stop signals at their default action. magsim-scene keeps a signal
+    that its caller ignores ignored (nohup), so without this the family would test how the
+    fuzz itself was started."""
+    for sig in STOP_SIGNALS:
+        signal.signal(sig, signal.SIG_DFL)
+
+
 def fam_signal(rng, out, timeout):
     """A stop signal mid-run: exit 128 + signal, summary.json interrupted, whole CSV rows."""
     sig = rng.choice(STOP_SIGNALS)
     states = os.path.join(out, "states.csv")
     p = subprocess.Popen([SCENE, "balls_up", "--count", str(rng.randint(3, 60)), "--steps", "100000",
                           "--fps", "1000", "--no-render", "--threads", "1", "--out", out],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                         preexec_fn=default_stop_signals)
     want, t0, started = rng.randint(1, 300000), time.monotonic(), False
     while time.monotonic() - t0 < 10 and p.poll() is None:
         try:
