@@ -73,12 +73,13 @@ finite = all(v is not None and math.isfinite(v) for v in ser["max_speed"] + ser[
 ok = s["error"] is None and finite and peak <= bound
 # the energy criterion holds where the force has one (energy.conservative)
 rise, lost, ratio = energy_figures(ser)
-if s.get("energy", {}).get("conservative") and rise is not None:
+conservative = s.get("energy", {}).get("conservative")
+if conservative and rise is not None:
     e_ok = rise <= 0.01 * lost if lost > 0 else rise <= 0.0
     energy = f"{rise:.2g} of {lost:.3g}" + ("" if e_ok else " (>1 %)")
     ok = ok and e_ok
 else:
-    energy = "no energy (eq. 4)" if not s.get("energy", {}).get("conservative") else "n/a"
+    energy = "n/a" if conservative else "no energy (eq. 4)"
 err = (s["error"] or "")[:60]
 print(f"| {peak:.3g} | {ke if ke is not None else float('nan'):.3g} | {energy} | {s['substeps']['mean'] if 'substeps' in s else 1:.2f} | {err} | {'ok' if ok else 'FAIL'} |")
 PY
