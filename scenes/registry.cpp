@@ -131,11 +131,13 @@ SceneDesc balls_up(const SceneParams& p) {
 // ---------------------------------------------------------------------------------------
 // alphabets — 100 letter pieces (iron, 3 cm tall, 5 mm strokes, 1 induced moment per
 // stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible, "excessively strong"
-// 300 A·m² moment at the grid centre with an invisible collider of radius 2 cm (the paper's
-// fiction: no real magnet of that size carries it; an N52 sphere of 300 A·m² would have a
-// radius of 4.4 cm). Where a stroke lies on the collider its moment is 2.25 cm from the
-// centre: |H| = 2m/(4π r³) = 4.2 MA/m = 2.6 Ms on the axis, inside Fig. 9's region
-// |H| ≥ 2.5 Ms where Kim 2018's dynamics fails. Letters arrive at up to 15 m/s, so the frame
+// 600 A·m² moment at the grid centre with an invisible collider of radius 2 cm (the paper's
+// fiction: no real magnet of that size carries it; an N52 sphere of 600 A·m² would have a
+// radius of 5.1 cm at 1.1e6 A/m). Where a stroke lies on the collider its moment is 2.25 cm from the
+// centre: |H| = 2m/(4π r³) = 8.4 MA/m = 5.2 Ms on the axis, inside Fig. 9's region
+// |H| ≥ 2.5 Ms where Kim 2018's dynamics fails. 600 rather than 300 A·m²: the grid's corner
+// letters start 0.22 m out, where the pull falls as r⁻⁷, and at 300 A·m² they were still
+// arriving 1.5 s in (tools/findings/energy.md). Letters arrive at up to 15 m/s, so the frame
 // splits into up to 16 rigid sub-steps where bodies in contact move fast or are pressed hard
 // into their contacts (tools/findings/alphabets.md).
 struct Stroke {
@@ -202,7 +204,7 @@ SceneDesc alphabets(const SceneParams& p) {
   }
   const double Rc = 0.02;  // (m) radius of the invisible collider around the central moment
   BodyDesc c = magnet_body("centre", BodyType::Static, Vec3::Zero(), ShapeKind::Sphere, Vec3(Rc, Rc, Rc),
-                           {permanent_moment(sphere_volume(Rc), Vec3(0, 0, 300.0 * p.strength))});
+                           {permanent_moment(sphere_volume(Rc), Vec3(0, 0, 600.0 * p.strength))});
   c.visible = false;
   c.color = BodyDesc{}.color;  // never drawn
   s.bodies.push_back(c);
