@@ -61,8 +61,9 @@ Mat3 eddy_flux_gradient(mag::Curve curve, const Vec3& H, double Ms, const Mat3& 
   return mag::kMu0 * (Mat3::Identity() + (2.0 / 3.0) * mag::curve_dMdH(curve, H, Ms)) * J;
 }
 
-void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s, double h,
-                       Workspace* ws, OdeBridge* ode) {
+void apply_eddy_losses(const Model& m, const mag::MomentDesc& set,
+                       const mag::Magnetization& mz, const State& s, double h, Workspace* ws,
+                       OdeBridge* ode) {
   const double sigma = m.options.eddy_conductivity;
   if (!(sigma > 0.0)) {  // off: empty vectors tell the energy audit there is no such force
     ws->eddy_force.clear();
@@ -87,7 +88,7 @@ void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s
     bool any = false;
     for (int j = adr; j < adr + num; ++j) {
       if (m.moment_permanent[j]) continue;
-      const Vec3 B = eddy_flux_density(H[j], set.M[j]);
+      const Vec3 B = eddy_flux_density(H[j], mz.M[j]);
       const Vec3 Bbody = R.transpose() * B;
       if (have_prev && ode->enabled(b)) {
         const Vec3 Bdot = R * (Bbody - ws->eddy_B[j]) / ws->eddy_h;
