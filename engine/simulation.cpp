@@ -94,9 +94,8 @@ void Simulation::rollback() {
     ode_->discard_contacts();
   }
   ode_->write_state(state_);
-  ws_.eddy_h = 0.0;  // the eddy loss's last flux densities belong to the failed step
   ws_.forces_ready = false;  // the next step evaluates them from state_'s magnetization
-  // the next attempt takes state_'s magnetization afresh (attempt, step.cpp)
+  // the next attempt takes state_'s magnetization and eddy memory afresh (attempt, step.cpp)
   place_moments(*model_, state_, &moments_, nullptr);
 }
 

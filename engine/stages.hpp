@@ -55,11 +55,12 @@ void torque_balance_forces(const std::vector<Vec3>& x, const std::vector<double>
 /// SimOptions::eddy_conductivity: the eddy-current loss of the induced moments' bodies,
 /// taken implicitly over the ODE step h starting at the poses of s with the magnetization mz,
 /// added to ODE as a force and torque per body (ws->eddy_force, ws->eddy_torque: empty when
-/// σ = 0, zero on the first step). Needs the fields and Jacobians of the force stage
-/// (ws->mag.H, ws->mag.J).
+/// σ = 0, zero while *memory holds no previous step). Reads the last ODE step's flux
+/// densities from *memory and leaves this step's there. Needs the fields and Jacobians of
+/// the force stage (ws->mag.H, ws->mag.J).
 void apply_eddy_losses(const Model& model, const mag::MomentDesc& set,
-                       const mag::Magnetization& mz, const State& s, double h, Workspace* ws,
-                       OdeBridge* ode);
+                       const mag::Magnetization& mz, const State& s, double h,
+                       EddyMemory* memory, Workspace* ws, OdeBridge* ode);
 /// c = σ a² V / 10 (a = the radius of a sphere of volume V): P = c |Ḃ|² (W).
 double eddy_coefficient(double conductivity, double volume);
 /// B = μ0 (H + ⅔ M), the flux density inside a uniformly magnetized sphere in the field H (T).

@@ -1,6 +1,7 @@
 // engine/state.cpp — initial state, shape check and the FNV-1a state hash.
 #include "engine/state.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -79,6 +80,12 @@ void check_state_shape(const Model& m, const State& s) {
     throw std::invalid_argument("State does not fit the model: mag_accel has " +
                                 std::to_string(s.mag_accel.size()) + " entries, expected " +
                                 std::to_string(nb) + " (or none)");
+  if (!s.eddy.B.empty() && s.eddy.B.size() != nm)
+    throw std::invalid_argument("State does not fit the model: eddy.B has " +
+                                std::to_string(s.eddy.B.size()) + " entries, expected " +
+                                std::to_string(nm) + " (or none)");
+  if (!(s.eddy.h >= 0.0) || !std::isfinite(s.eddy.h))
+    throw std::invalid_argument("State eddy.h is negative or not finite");
   if (s.step < 0) throw std::invalid_argument("State step count is negative");
 }
 

@@ -12,6 +12,14 @@
 
 namespace magsim::engine {
 
+/// What the eddy-current loss remembers of the last ODE step (eddy.cpp).
+struct EddyMemory {
+  /// (nmoment) each induced moment's flux density in its body's frame at the start of the
+  /// last ODE step (T); empty = none yet
+  std::vector<Vec3> B;
+  double h = 0.0;  ///< that step's length (s); 0 = none yet
+};
+
 struct State {
   long step = 0;  ///< rigid steps taken; time = step · Δt_r
 
@@ -38,6 +46,10 @@ struct State {
   /// the next step's sub-steps (SimOptions::substep_load). Derived data as dvel: kept so that
   /// a restored state continues as the original; not part of the hash. Empty = zero.
   std::vector<double> mag_accel;
+  /// SimOptions::eddy_conductivity (eddy.cpp): the loss measures Ḃ as the change of each
+  /// moment's flux density in its body's frame over the last ODE step. Derived data as dvel:
+  /// kept so that a restored state continues as the original; not part of the hash.
+  EddyMemory eddy;
   /// mag.M is the converged magnetization at these poses (every state a step produced): the
   /// next step's first forces need no solve. false at t = 0 (unmagnetized). Not hashed.
   bool magnetized = false;

@@ -13,9 +13,10 @@
 //   the energy guard: E = K + U_g + U* rose too much → retake in more sub-steps
 //   commit, with the energy audit of the step                  energy.cpp
 //
-// The step works on ws_.next — the magnetics solvers on its magnetization, taken from
-// state_ when an attempt begins — and swaps it into state_ only when every check passes, so
-// state_ is always the last good state; on failure ODE is rewound to it.
+// The step works on ws_.next — the magnetics solvers on its magnetization, the eddy loss on
+// its memory, both taken from state_ when an attempt begins — and swaps it into state_ only
+// when every check passes, so state_ is always the last good state; on failure ODE is
+// rewound to it.
 #include "engine/simulation.hpp"
 
 #include "engine/ode_bridge.hpp"
@@ -83,13 +84,15 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
   State& next = ws_.next;
   mag::Magnetization& mz = next.mag;  // the magnetization the step evolves
 
-  // (1) ODE takes the state; the next state starts from its magnetization; moments take
-  //     world positions (and permanent moments their world orientation) from their bodies
+  // (1) ODE takes the state; the next state starts from its magnetization and eddy memory;
+  //     moments take world positions (and permanent moments their world orientation) from
+  //     their bodies
   {
     ScopedTimer t(&prof.sync_ms);
     ode_->write_state(state_);
     if (inject_body_ >= 0) ode_->set_velocity(inject_body_, inject_velocity_);
     mz = state_.mag;
+    next.eddy = state_.eddy;
     place_moments(m, state_, &moments_, &mz);
   }
 
@@ -121,7 +124,7 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
       ScopedTimer t(&prof.T_f);
       apply_magnetic_forces(m, moments_, mz, &ws_, ode_.get());
       // (3b) the eddy-current loss of conducting bodies (off unless the scene sets σ)
-      apply_eddy_losses(m, moments_, mz, now, h, &ws_, ode_.get());
+      apply_eddy_losses(m, moments_, mz, now, h, &next.eddy, &ws_, ode_.get());
     }
 
     // (4) collide and step the rigid bodies over h
