@@ -94,6 +94,14 @@ class Simulation {
   /// (E at both ends, ws_.coenergy_start and ws_.audit.magnetic_energy); nothing committed.
   /// The contacts are as soft as at nsub_soft sub-steps (the count the scene chose).
   void attempt(int nsub, int nsub_soft, long n);
+  /// The end of an attempt whose last ODE sub-step (of length h, nsub sub-steps) is taken:
+  /// reads ws_.next back from ODE and checks it, then completes it — velocity change,
+  /// converged magnetization, the forces the next step starts with (ws_.F), their load
+  /// (mag_accel) — and the audit's last sub-step and U*.
+  void assemble_next(int nsub, double h, long n);
+  /// Makes the assembled ws_.next and its audit the current state_ and energy_, with the
+  /// energy guard's statistics of the step (retakes, and retakes that did not resolve).
+  void commit(long retakes, long unresolved);
   /// Stages 2 and 3 at the moments' current poses: the solve of *mz (unless it is already
   /// the converged magnetization) and the forces into ws_ (not applied).
   void solve_magnetics(mag::Magnetization* mz, bool solve, long n);

@@ -7,7 +7,7 @@
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
 //   (3b) eddy-current loss (scenes that set a conductivity)   eddy.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
-//   then read back, check for non-finite values                safety.cpp
+//   assemble_next: read back, check for non-finite values      safety.cpp
 //   (2)+(3) again at the end state: its converged magnetization, U*, and the forces the
 //   next step starts with (so a frame solves once per sub-step, as before)
 //   the energy guard: E = K + U_g + U* rose too much → retake in more sub-steps
@@ -148,7 +148,13 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
       }
     }
   }
+  assemble_next(nsub, h, n);
+}
 
+void Simulation::assemble_next(int nsub, double h, long n) {
+  const Model& m = *model_;
+  StepProfile& prof = profile_;
+  State& next = ws_.next;
   // read back and check the end state
   {
     ScopedTimer t(&prof.check_ms);
@@ -177,6 +183,20 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
       next.mag_accel[b] = F.norm() / m.body_mass[b];
     }
   ws_.audit.magnetic_energy = coenergy(next.mag);
+}
+
+void Simulation::commit(long retakes, long unresolved) {
+  profile_.guard_retakes = static_cast<int>(retakes);
+  ws_.audit.guard_retakes += retakes;
+  ws_.audit.guard_unresolved += unresolved;
+  ws_.audit.total.energy_created += ws_.audit.last.energy_created;
+  ws_.audit.total.energy_dissipated += ws_.audit.last.energy_dissipated;
+  if (energy_.substeps == 0)  // the audit's first step: E at its start
+    ws_.audit.initial_total = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
+  std::swap(energy_, ws_.audit);
+  std::swap(state_, ws_.next);
+  ws_.forces_ready = true;  // the forces of assemble_next's solve belong to the new state_
+  inject_body_ = -1;
 }
 
 void Simulation::step() {
@@ -227,19 +247,7 @@ void Simulation::step() {
       rollback();
       nsub = std::min(2 * nsub, o.energy_guard_max_substeps);
     }
-    profile_.guard_retakes = static_cast<int>(retakes);
-    ws_.audit.guard_retakes += retakes;
-    ws_.audit.guard_unresolved += unresolved;
-    ws_.audit.total.energy_created += ws_.audit.last.energy_created;
-    ws_.audit.total.energy_dissipated += ws_.audit.last.energy_dissipated;
-    if (energy_.substeps == 0)  // the audit's first step: E at its start
-      ws_.audit.initial_total = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
-
-    // commit
-    std::swap(energy_, ws_.audit);
-    std::swap(state_, ws_.next);
-    ws_.forces_ready = true;
-    inject_body_ = -1;
+    commit(retakes, unresolved);
   } catch (const SimulationError&) {
     inject_body_ = -1;
     rollback();
