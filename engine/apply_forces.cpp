@@ -140,7 +140,8 @@ void balance_magnetic_torque(const Model& m, const mag::MomentDesc& set,
     const int adr = m.body_moment_adr[b], num = m.body_moment_num[b];
     for (int j = adr; j < adr + num; ++j)
       if (!m.moment_permanent[j])
-        share += 0.5 * mag::kMu0 * (eff.moment(j).cross(H[j]) + mag::moment(set, mz, j).cross(Ht[j]));
+        share += 0.5 * mag::kMu0 *
+                 (eff.moment(j).cross(H[j]) + mag::moment(set, mz, j).cross(Ht[j]));
     L -= share;
     ws->balance_x[b] = ode->position(b);
     ws->balance_w[b] = share.norm();

@@ -59,8 +59,8 @@ struct State {
 State initial_state(const Model& model);
 
 /// 64-bit FNV-1a over the exact bytes of poses, velocities and magnetizations (pos, quat,
-/// vel, angvel, mag.M1, mag.M2, mag.M, in that order). Equal hashes ⇔ bit-identical states (up to
-/// hash collisions).
+/// vel, angvel, mag.M1, mag.M2, mag.M, in that order). Equal hashes ⇔ bit-identical states
+/// (up to hash collisions).
 std::uint64_t state_hash(const State& s);
 
 /// Throws std::invalid_argument when `s` does not fit `model` (array sizes).

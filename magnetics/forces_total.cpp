@@ -70,8 +70,9 @@ void permanent_field(const MomentDesc& set, const Magnetization& mz, const Field
 }
 
 void zeeman_total_forces(const MomentDesc& set, const Magnetization& mz, Curve curve,
-                         const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F, std::vector<Vec3>* tau,
-                         std::vector<Vec3>* F_classic, double tol, int max_iter) {
+                         const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
+                         std::vector<Vec3>* tau, std::vector<Vec3>* F_classic, double tol,
+                         int max_iter) {
   ZeemanTotalScratch& t = ws->total;
   const std::size_t n = set.size();
   t.idx.clear();

@@ -53,7 +53,7 @@ inline Vec3 moment(const MomentDesc& d, const Magnetization& mz, std::size_t j) 
 }
 
 /// A magnetic system in one piece, description and magnetization (tools, tests, scratch).
-/// Every solver that takes (MomentDesc, Magnetization) also takes a MomentSet.
+/// The solvers take (MomentDesc, Magnetization); their MomentSet forms pass the set as both.
 struct MomentSet : MomentDesc, Magnetization {
   /// Adds an unmagnetized induced moment (M = 0; its sub-pair axis is seeded on the first
   /// dynamics iteration, perpendicular to the field it feels). Returns its index.
