@@ -12,14 +12,15 @@
 
 namespace magsim::engine {
 
-void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
-  mag::compute_forces(set, resolved_force_model(m.options), mag::curve_of(m.options.method),
+void compute_magnetic_forces(const Model& m, const mag::MomentDesc& set,
+                             const mag::Magnetization& mz, Workspace* ws) {
+  mag::compute_forces(set, mz, resolved_force_model(m.options), mag::curve_of(m.options.method),
                       m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
                       m.options.reaction_symmetric_forces);
 }
 
-void apply_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws,
-                           OdeBridge* ode) {
+void apply_magnetic_forces(const Model& m, const mag::MomentDesc& set,
+                           const mag::Magnetization& mz, Workspace* ws, OdeBridge* ode) {
   // net magnetic force per body, and the torque about its COM x_b that ODE will make of the
   // forces at the moments' positions and the permanent moments' torques:
   //   F_b = Σ_j F_j,  τ_b = Σ_j (p_j − x_b) × F_j + τ_j (τ_j of permanent moments only)
@@ -37,7 +38,7 @@ void apply_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace*
     }
   }
 
-  if (m.options.balance_magnetic_torque) balance_magnetic_torque(m, set, ws, ode);
+  if (m.options.balance_magnetic_torque) balance_magnetic_torque(m, set, mz, ws, ode);
 
   // auto-disable: ODE sleeps on small velocities only, so wake a sleeping body whose
   // magnetic load changed by more than 5 % of its weight (|g| taken ≥ 1 m/s²) since it
@@ -123,8 +124,8 @@ void torque_balance_forces(const std::vector<Vec3>& x, const std::vector<double>
 // lands where the torque arises (mass weights over every body did worse: at ×3, 1.2 s, KE
 // 4.6 J and a ball at 12.8 m/s; they load the farthest balls most, whose lever arms are the
 // longest). Applied to the awake dynamic bodies; a sleeping body takes no share.
-void balance_magnetic_torque(const Model& m, const mag::MomentSet& set, Workspace* ws,
-                             const OdeBridge* ode) {
+void balance_magnetic_torque(const Model& m, const mag::MomentDesc& set,
+                             const mag::Magnetization& mz, Workspace* ws, const OdeBridge* ode) {
   ws->balance_force.clear();
   const std::vector<Vec3>& Ht = ws->mag.H_eff_src;  // set by the reaction-symmetric forces
   if (Ht.size() != set.size()) return;             // classic or zeeman-total: no such torque
@@ -139,7 +140,8 @@ void balance_magnetic_torque(const Model& m, const mag::MomentSet& set, Workspac
     const int adr = m.body_moment_adr[b], num = m.body_moment_num[b];
     for (int j = adr; j < adr + num; ++j)
       if (!m.moment_permanent[j])
-        share += 0.5 * mag::kMu0 * (eff.moment(j).cross(H[j]) + set.moment(j).cross(Ht[j]));
+        share += 0.5 * mag::kMu0 *
+                 (eff.moment(j).cross(H[j]) + mag::moment(set, mz, j).cross(Ht[j]));
     L -= share;
     ws->balance_x[b] = ode->position(b);
     ws->balance_w[b] = share.norm();

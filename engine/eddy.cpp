@@ -28,8 +28,9 @@
 // any σ, and ODE applies it with the other forces (its contacts see it). Q_b drags a body
 // toward the motion of the field it sits in; the reaction on the sources is not applied (the
 // field's sources are not split per pair), so momentum is not conserved by this force.
-// The first step after a start, restore_state or a rollback has no previous B and takes no
-// loss (a restored run then differs from the uninterrupted one from that step on).
+// The first ODE step of a run has no previous B and takes no loss. The previous B is
+// State::eddy, so a restored state, or a step retaken after a rollback, measures Ḃ as the
+// uninterrupted run does.
 #include "engine/stages.hpp"
 
 #include "magnetics/curves.hpp"
@@ -61,8 +62,9 @@ Mat3 eddy_flux_gradient(mag::Curve curve, const Vec3& H, double Ms, const Mat3& 
   return mag::kMu0 * (Mat3::Identity() + (2.0 / 3.0) * mag::curve_dMdH(curve, H, Ms)) * J;
 }
 
-void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s, double h,
-                       Workspace* ws, OdeBridge* ode) {
+void apply_eddy_losses(const Model& m, const mag::MomentDesc& set,
+                       const mag::Magnetization& mz, const State& s, double h,
+                       EddyMemory* memory, Workspace* ws, OdeBridge* ode) {
   const double sigma = m.options.eddy_conductivity;
   if (!(sigma > 0.0)) {  // off: empty vectors tell the energy audit there is no such force
     ws->eddy_force.clear();
@@ -74,8 +76,8 @@ void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s
   const mag::Curve curve = mag::curve_of(m.options.method);
   const std::vector<Vec3>& H = ws->mag.H;
   const std::vector<Mat3>& J = ws->mag.J;
-  const bool have_prev = ws->eddy_h > 0.0 && ws->eddy_B.size() == set.size();
-  ws->eddy_B.resize(set.size());
+  const bool have_prev = memory->h > 0.0 && memory->B.size() == set.size();
+  memory->B.resize(set.size());
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   for (int b : m.dynamic_bodies) {
@@ -87,10 +89,10 @@ void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s
     bool any = false;
     for (int j = adr; j < adr + num; ++j) {
       if (m.moment_permanent[j]) continue;
-      const Vec3 B = eddy_flux_density(H[j], set.M[j]);
+      const Vec3 B = eddy_flux_density(H[j], mz.M[j]);
       const Vec3 Bbody = R.transpose() * B;
       if (have_prev && ode->enabled(b)) {
-        const Vec3 Bdot = R * (Bbody - ws->eddy_B[j]) / ws->eddy_h;
+        const Vec3 Bdot = R * (Bbody - memory->B[j]) / memory->h;
         const Mat3 G = eddy_flux_gradient(curve, H[j], set.Ms[j], J[j]);
         Eigen::Matrix<double, 3, 6> D;
         D.leftCols<3>() = G;
@@ -100,7 +102,7 @@ void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s
         g += c * D.transpose() * Bdot;
         any = true;
       }
-      ws->eddy_B[j] = Bbody;
+      memory->B[j] = Bbody;
     }
     if (!any) continue;
     Mat6 Mb = Mat6::Zero();
@@ -113,7 +115,7 @@ void apply_eddy_losses(const Model& m, const mag::MomentSet& set, const State& s
     ode->add_force_at(b, ws->eddy_force[b], s.pos[b]);
     ode->add_torque(b, ws->eddy_torque[b]);
   }
-  ws->eddy_h = h;
+  memory->h = h;
 }
 
 }  // namespace magsim::engine

@@ -52,10 +52,10 @@ render::Frame build_frame(const Model& m, const State& s, const FrameOptions& op
         const Vec3 mw = s.quat[b] * m.moment_m[j];
         if (opt.permanent_arrows && mw.norm() > 0)
           f.arrows.push_back(arrow(p, len * mw.normalized(), {0.1f, 0.75f, 0.2f}));
-      } else if (opt.magnetization_arrows && s.seeded[j]) {
+      } else if (opt.magnetization_arrows && s.mag.seeded[j]) {
         const double Ms = m.moment_Ms[j];
-        f.arrows.push_back(arrow(p, (len / Ms) * s.M1[j], {0.9f, 0.1f, 0.1f}));
-        f.arrows.push_back(arrow(p, (len / Ms) * s.M2[j], {0.1f, 0.2f, 0.9f}));
+        f.arrows.push_back(arrow(p, (len / Ms) * s.mag.M1[j], {0.9f, 0.1f, 0.1f}));
+        f.arrows.push_back(arrow(p, (len / Ms) * s.mag.M2[j], {0.1f, 0.2f, 0.9f}));
       }
     }
   }

@@ -3,7 +3,8 @@
 // compile_model() validates the description (std::invalid_argument naming the body and the
 // field) and lays it out as structure-of-arrays, MuJoCo style: per-body mass properties,
 // shapes and moments addressed by (adr, num) ranges, moments in body order so that moment
-// j of the Model is moment j of the MomentSet, with group id = its body index.
+// j of the Model is moment j of the magnetics layer's MomentDesc (make_moment_desc), with
+// group id = its body index.
 //
 // Body frame choice: the engine's body frame is the **centre-of-mass frame** — the
 // BodyDesc frame translated by the centre of mass c (same orientation), because ODE needs

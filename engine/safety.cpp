@@ -33,14 +33,14 @@ template <class V>
 
 }  // namespace
 
-void check_magnetization(const Model& m, const mag::MomentSet& set, long step) {
+void check_magnetization(const Model& m, const mag::Magnetization& mz, long step) {
   for (int j = 0; j < m.nmoment; ++j) {
-    if (!set.M[j].allFinite())
-      raise(m, step, m.moment_body[j], "magnetization", set.M[j], " of moment " + std::to_string(j));
-    if (!set.M1[j].allFinite())
-      raise(m, step, m.moment_body[j], "magnetization", set.M1[j], " M1 of moment " + std::to_string(j));
-    if (!set.M2[j].allFinite())
-      raise(m, step, m.moment_body[j], "magnetization", set.M2[j], " M2 of moment " + std::to_string(j));
+    if (!mz.M[j].allFinite())
+      raise(m, step, m.moment_body[j], "magnetization", mz.M[j], " of moment " + std::to_string(j));
+    if (!mz.M1[j].allFinite())
+      raise(m, step, m.moment_body[j], "magnetization", mz.M1[j], " M1 of moment " + std::to_string(j));
+    if (!mz.M2[j].allFinite())
+      raise(m, step, m.moment_body[j], "magnetization", mz.M2[j], " M2 of moment " + std::to_string(j));
   }
 }
 

@@ -33,7 +33,7 @@ class SimulationError : public std::runtime_error {
 };
 
 /// Throws SimulationError for the first non-finite M, M1 or M2 (in moment order).
-void check_magnetization(const Model& model, const mag::MomentSet& set, long step);
+void check_magnetization(const Model& model, const mag::Magnetization& mz, long step);
 /// Throws SimulationError for the first non-finite magnetic force or torque.
 void check_forces(const Model& model, const Workspace& ws, long step);
 /// Throws SimulationError for the first non-finite position, orientation, velocity or

@@ -33,9 +33,8 @@ Simulation::Simulation(const SceneDesc& scene)
   const Model& m = *model_;
   const int all_threads = default_omp_threads();  // the count at the first Simulation
   state_ = initial_state(m);
-  moments_ = make_moment_set(m);
-  load_magnetization(state_, &moments_);
-  place_moments(m, state_, &moments_);
+  moments_ = make_moment_desc(m);
+  place_moments(m, state_, &moments_, nullptr);
   ws_.F.assign(m.nmoment, Vec3::Zero());
   ws_.tau.assign(m.nmoment, Vec3::Zero());
   ws_.body_force.assign(m.nbody, Vec3::Zero());
@@ -95,10 +94,9 @@ void Simulation::rollback() {
     ode_->discard_contacts();
   }
   ode_->write_state(state_);
-  ws_.eddy_h = 0.0;  // the eddy loss's last flux densities belong to the failed step
   ws_.forces_ready = false;  // the next step evaluates them from state_'s magnetization
-  load_magnetization(state_, &moments_);
-  place_moments(*model_, state_, &moments_);
+  // the next attempt takes state_'s magnetization and eddy memory afresh (attempt, step.cpp)
+  place_moments(*model_, state_, &moments_, nullptr);
 }
 
 render::Frame Simulation::frame(const FrameOptions& opt) const {

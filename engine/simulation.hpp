@@ -61,7 +61,9 @@ class Simulation {
 
   render::Frame frame(const FrameOptions& opt = {}) const;
 
-  const mag::MomentSet& moments() const { return moments_; }
+  /// The moments' description at the poses of the last step (world positions, permanent
+  /// moments); their magnetizations are state().mag.
+  const mag::MomentDesc& moments() const { return moments_; }
   const Model& model() const { return *model_; }
   const State& state() const { return state_; }
 
@@ -92,17 +94,26 @@ class Simulation {
   /// (E at both ends, ws_.coenergy_start and ws_.audit.magnetic_energy); nothing committed.
   /// The contacts are as soft as at nsub_soft sub-steps (the count the scene chose).
   void attempt(int nsub, int nsub_soft, long n);
-  /// Stages 2 and 3 at the moments' current poses: the magnetization solve (unless the
-  /// magnetization is already the converged one) and the forces into ws_ (not applied).
-  void solve_magnetics(bool solve, long n);
-  /// U* (or zeeman-total's E_sys) from the field of the last force evaluation (J).
-  double coenergy() const;
+  /// The end of an attempt whose last ODE sub-step (of length h, nsub sub-steps) is taken:
+  /// reads ws_.next back from ODE and checks it, then completes it — velocity change,
+  /// converged magnetization, the forces the next step starts with (ws_.F), their load
+  /// (mag_accel) — and the audit's last sub-step and U*.
+  void assemble_next(int nsub, double h, long n);
+  /// Makes the assembled ws_.next and its audit the current state_ and energy_, with the
+  /// energy guard's statistics of the step (retakes, and retakes that did not resolve).
+  void commit(long retakes, long unresolved);
+  /// Stages 2 and 3 at the moments' current poses: the solve of *mz (unless it is already
+  /// the converged magnetization) and the forces into ws_ (not applied).
+  void solve_magnetics(mag::Magnetization* mz, bool solve, long n);
+  /// U* (or zeeman-total's E_sys) of the magnetization mz from the field of the last force
+  /// evaluation (J).
+  double coenergy(const mag::Magnetization& mz) const;
   void rollback();
   void check_body_index(int i) const;
 
   std::unique_ptr<const Model> model_;
   State state_;             ///< the last good state (end of the last successful step)
-  mag::MomentSet moments_;  ///< persists between steps: the warm start of the dynamics
+  mag::MomentDesc moments_;  ///< placed at the poses of the (sub-)step being taken
   Workspace ws_;
   std::unique_ptr<OdeBridge> ode_;
   StepProfile profile_;

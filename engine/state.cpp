@@ -1,6 +1,7 @@
 // engine/state.cpp — initial state, shape check and the FNV-1a state hash.
 #include "engine/state.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -15,15 +16,16 @@ State initial_state(const Model& m) {
   s.dvel.assign(m.nbody, Vec3::Zero());
   s.mag_accel.assign(m.nbody, 0.0);
   s.enabled.assign(m.nbody, 1);
-  s.M1.assign(m.nmoment, Vec3::Zero());
-  s.M2.assign(m.nmoment, Vec3::Zero());
-  s.M.assign(m.nmoment, Vec3::Zero());
-  s.seeded.assign(m.nmoment, 0);
+  mag::Magnetization& mz = s.mag;
+  mz.M1.assign(m.nmoment, Vec3::Zero());
+  mz.M2.assign(m.nmoment, Vec3::Zero());
+  mz.M.assign(m.nmoment, Vec3::Zero());
+  mz.seeded.assign(m.nmoment, 0);
   for (int j = 0; j < m.nmoment; ++j) {
     if (!m.moment_permanent[j]) continue;
-    // a permanent moment's M = m/V in world axes, M1 = M2 = 0 (as mag::MomentSet keeps it)
-    s.M[j] = (m.body_quat0[m.moment_body[j]] * m.moment_m[j]) / m.moment_volume[j];
-    s.seeded[j] = 1;
+    // a permanent moment's M = m/V in world axes, M1 = M2 = 0 (as mag::Magnetization keeps it)
+    mz.M[j] = (m.body_quat0[m.moment_body[j]] * m.moment_m[j]) / m.moment_volume[j];
+    mz.seeded[j] = 1;
   }
   return s;
 }
@@ -53,9 +55,9 @@ std::uint64_t state_hash(const State& s) {
   for (const Quat& q : s.quat) f.bytes(q.coeffs().data(), 4 * sizeof(double));
   f.vecs(s.vel);
   f.vecs(s.angvel);
-  f.vecs(s.M1);
-  f.vecs(s.M2);
-  f.vecs(s.M);
+  f.vecs(s.mag.M1);
+  f.vecs(s.mag.M2);
+  f.vecs(s.mag.M);
   return f.h;
 }
 
@@ -66,9 +68,10 @@ void check_state_shape(const Model& m, const State& s) {
       s.enabled.size() != nb)
     throw std::invalid_argument("State does not fit the model: expected " + std::to_string(nb) +
                                 " bodies, got " + std::to_string(s.pos.size()));
-  if (s.M1.size() != nm || s.M2.size() != nm || s.M.size() != nm || s.seeded.size() != nm)
+  const mag::Magnetization& mz = s.mag;
+  if (mz.M1.size() != nm || mz.M2.size() != nm || mz.M.size() != nm || mz.seeded.size() != nm)
     throw std::invalid_argument("State does not fit the model: expected " + std::to_string(nm) +
-                                " moments, got " + std::to_string(s.M.size()));
+                                " moments, got " + std::to_string(mz.M.size()));
   if (!s.dvel.empty() && s.dvel.size() != nb)
     throw std::invalid_argument("State does not fit the model: dvel has " +
                                 std::to_string(s.dvel.size()) + " entries, expected " +
@@ -77,6 +80,12 @@ void check_state_shape(const Model& m, const State& s) {
     throw std::invalid_argument("State does not fit the model: mag_accel has " +
                                 std::to_string(s.mag_accel.size()) + " entries, expected " +
                                 std::to_string(nb) + " (or none)");
+  if (!s.eddy.B.empty() && s.eddy.B.size() != nm)
+    throw std::invalid_argument("State does not fit the model: eddy.B has " +
+                                std::to_string(s.eddy.B.size()) + " entries, expected " +
+                                std::to_string(nm) + " (or none)");
+  if (!(s.eddy.h >= 0.0) || !std::isfinite(s.eddy.h))
+    throw std::invalid_argument("State eddy.h is negative or not finite");
   if (s.step < 0) throw std::invalid_argument("State step count is negative");
 }
 

@@ -4,12 +4,21 @@
 #pragma once
 
 #include "engine/model.hpp"
+#include "magnetics/moments.hpp"
 
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 namespace magsim::engine {
+
+/// What the eddy-current loss remembers of the last ODE step (eddy.cpp).
+struct EddyMemory {
+  /// (nmoment) each induced moment's flux density in its body's frame at the start of the
+  /// last ODE step (T); empty = none yet
+  std::vector<Vec3> B;
+  double h = 0.0;  ///< that step's length (s); 0 = none yet
+};
 
 struct State {
   long step = 0;  ///< rigid steps taken; time = step · Δt_r
@@ -21,10 +30,10 @@ struct State {
   std::vector<Vec3> angvel;            ///< (nbody) rad/s, world frame
   std::vector<std::uint8_t> enabled;   ///< (nbody) 0 = put to sleep by ODE's auto-disable
 
-  // moments, in Model / MomentSet order
-  std::vector<Vec3> M1, M2;            ///< (nmoment) sub-magnetizations (A/m)
-  std::vector<Vec3> M;                 ///< (nmoment) magnetization (A/m)
-  std::vector<std::uint8_t> seeded;    ///< (nmoment) the sub-pair axis has been chosen
+  /// (nmoment, Model order) the moments' magnetizations: sub-magnetizations M1, M2 and
+  /// M = (M1 + M2)/2 (A/m), whether the sub-pair axis has been chosen. The only copy: the
+  /// magnetics solvers work on the State being computed (Simulation::step).
+  mag::Magnetization mag;
 
   /// Body pairs (a < b) in contact during the last step, −1 = the ground plane. Derived
   /// data kept for metrics (attachment graph); not part of the hash.
@@ -37,7 +46,11 @@ struct State {
   /// the next step's sub-steps (SimOptions::substep_load). Derived data as dvel: kept so that
   /// a restored state continues as the original; not part of the hash. Empty = zero.
   std::vector<double> mag_accel;
-  /// M is the converged magnetization at these poses (every state a step produced): the
+  /// SimOptions::eddy_conductivity (eddy.cpp): the loss measures Ḃ as the change of each
+  /// moment's flux density in its body's frame over the last ODE step. Derived data as dvel:
+  /// kept so that a restored state continues as the original; not part of the hash.
+  EddyMemory eddy;
+  /// mag.M is the converged magnetization at these poses (every state a step produced): the
   /// next step's first forces need no solve. false at t = 0 (unmagnetized). Not hashed.
   bool magnetized = false;
 };
@@ -46,8 +59,8 @@ struct State {
 State initial_state(const Model& model);
 
 /// 64-bit FNV-1a over the exact bytes of poses, velocities and magnetizations (pos, quat,
-/// vel, angvel, M1, M2, M, in that order). Equal hashes ⇔ bit-identical states (up to
-/// hash collisions).
+/// vel, angvel, mag.M1, mag.M2, mag.M, in that order). Equal hashes ⇔ bit-identical states
+/// (up to hash collisions).
 std::uint64_t state_hash(const State& s);
 
 /// Throws std::invalid_argument when `s` does not fit `model` (array sizes).

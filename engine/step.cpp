@@ -7,14 +7,16 @@
 //   (3) magnetic forces and torques onto the bodies           apply_forces.cpp
 //   (3b) eddy-current loss (scenes that set a conductivity)   eddy.cpp
 //   (4) collide + QuickStep                                   ode_bridge.cpp
-//   then read back, check for non-finite values                safety.cpp
+//   assemble_next: read back, check for non-finite values      safety.cpp
 //   (2)+(3) again at the end state: its converged magnetization, U*, and the forces the
 //   next step starts with (so a frame solves once per sub-step, as before)
 //   the energy guard: E = K + U_g + U* rose too much → retake in more sub-steps
 //   commit, with the energy audit of the step                  energy.cpp
 //
-// The step works on ws_.next and swaps it into state_ only when every check passes, so
-// state_ is always the last good state; on failure ODE and the moments are rewound to it.
+// The step works on ws_.next — the magnetics solvers on its magnetization, the eddy loss on
+// its memory, both taken from state_ when an attempt begins — and swaps it into state_ only
+// when every check passes, so state_ is always the last good state; on failure ODE is
+// rewound to it.
 #include "engine/simulation.hpp"
 
 #include "engine/ode_bridge.hpp"
@@ -48,29 +50,29 @@ class OmpThreadScope {
 
 }  // namespace
 
-double Simulation::coenergy() const {
+double Simulation::coenergy(const mag::Magnetization& mz) const {
   const Model& m = *model_;
   if (ws_.mag.H.size() != moments_.size()) return 0.0;
   // the potential of the force where it has its own (zeeman-total: E_sys, forces.hpp)
   if (resolved_force_model(m.options) == mag::ForceModel::ZeemanTotal)
-    return mag::zeeman_total_energy(moments_, mag::curve_of(m.options.method), ws_.mag.H,
+    return mag::zeeman_total_energy(moments_, mz, mag::curve_of(m.options.method), ws_.mag.H,
                                     ws_.mag.total.perm, ws_.mag.total.Hp);
-  return mag::magnetic_coenergy(moments_, mag::curve_of(m.options.method), ws_.mag.H);
+  return mag::magnetic_coenergy(moments_, mz, mag::curve_of(m.options.method), ws_.mag.H);
 }
 
-void Simulation::solve_magnetics(bool solve, long n) {
+void Simulation::solve_magnetics(mag::Magnetization* mz, bool solve, long n) {
   const Model& m = *model_;
   StepProfile& prof = profile_;
   // (2) magnetization dynamics on the Δt_m clock, warm-started from the last (sub-)step
   if (solve) {
     ScopedTimer t(&prof.T_i);
-    magnetize(m, &moments_, &ws_, &prof);
+    magnetize(m, moments_, mz, &ws_, &prof);
   }
-  check_magnetization(m, moments_, n);
+  check_magnetization(m, *mz, n);
   // (3) forces (eqs. 13–14 or eq. 4) and torques on the moments
   if (m.dynamic_moments) {
     ScopedTimer t(&prof.T_f);
-    compute_magnetic_forces(m, moments_, &ws_);
+    compute_magnetic_forces(m, moments_, *mz, &ws_);
     check_forces(m, ws_, n);
   }
 }
@@ -79,14 +81,19 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
   const Model& m = *model_;
   StepProfile& prof = profile_;
   begin_audit_step(energy_, &ws_.audit);
+  State& next = ws_.next;
+  mag::Magnetization& mz = next.mag;  // the magnetization the step evolves
 
-  // (1) ODE takes the state; moments take world positions (and permanent moments their
-  //     world orientation) from their bodies
+  // (1) ODE takes the state; the next state starts from its magnetization and eddy memory;
+  //     moments take world positions (and permanent moments their world orientation) from
+  //     their bodies
   {
     ScopedTimer t(&prof.sync_ms);
     ode_->write_state(state_);
     if (inject_body_ >= 0) ode_->set_velocity(inject_body_, inject_velocity_);
-    place_moments(m, state_, &moments_);
+    mz = state_.mag;
+    next.eddy = state_.eddy;
+    place_moments(m, state_, &moments_, &mz);
   }
 
   const double h = m.options.dt / nsub;
@@ -94,20 +101,20 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
   for (int k = 0; k < nsub; ++k) {
     if (k > 0) {  // later sub-steps: the moments follow the bodies ODE has moved
       ScopedTimer t(&prof.sync_ms);
-      ode_->read_state(&ws_.next);
-      place_moments(m, ws_.next, &moments_);
+      ode_->read_state(&next);
+      place_moments(m, next, &moments_, &mz);
       // energy audit of the sub-step just taken (its forces are still in ws_)
-      audit_substep(m, k == 1 ? state_ : ws_.sub_prev, ws_.next, ws_.body_force,
+      audit_substep(m, k == 1 ? state_ : ws_.sub_prev, next, ws_.body_force,
                     ws_.body_torque, ws_.eddy_force, ws_.eddy_torque, h, &ws_.audit);
-      ws_.sub_prev = ws_.next;
+      ws_.sub_prev = next;
     }
-    const State& now = k == 0 ? state_ : ws_.next;
+    const State& now = k == 0 ? state_ : next;  // the poses this sub-step starts from
 
     // (2), (3): the first sub-step takes the forces the last step left for this state (or,
     // after a restore or rollback, evaluates them from its converged magnetization)
     if (k > 0 || !ws_.forces_ready) {
-      solve_magnetics(k > 0 || !state_.magnetized, n);
-      if (k == 0) ws_.coenergy_start = coenergy();
+      solve_magnetics(&mz, k > 0 || !state_.magnetized, n);
+      if (k == 0) ws_.coenergy_start = coenergy(mz);
     } else {
       ws_.coenergy_start = energy_.magnetic_energy;  // the last step's audit, from this field
     }
@@ -115,9 +122,9 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
 
     if (m.dynamic_moments) {
       ScopedTimer t(&prof.T_f);
-      apply_magnetic_forces(m, moments_, &ws_, ode_.get());
+      apply_magnetic_forces(m, moments_, mz, &ws_, ode_.get());
       // (3b) the eddy-current loss of conducting bodies (off unless the scene sets σ)
-      apply_eddy_losses(m, moments_, now, h, &ws_, ode_.get());
+      apply_eddy_losses(m, moments_, mz, now, h, &next.eddy, &ws_, ode_.get());
     }
 
     // (4) collide and step the rigid bodies over h
@@ -126,7 +133,7 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
       {
         ScopedTimer c(&prof.collide_ms);
         ode_->update_margins(now, ws_.body_force, h);
-        prof.contacts = ode_->collide(&ws_.next.contact_pairs, h, m.options.dt / nsub_soft);
+        prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft);
       }
       ScopedTimer q(&prof.quickstep_ms);
       try {
@@ -134,16 +141,21 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
         ode_->quickstep(static_cast<unsigned long>(n) ^ (static_cast<unsigned long>(k) << 40), h);
       } catch (const OdeFailure& e) {
         // name the body that went bad when there is one, else report ODE's own words
-        ode_->read_state(&ws_.next);
-        check_bodies(m, ws_.next, n);
+        ode_->read_state(&next);
+        check_bodies(m, next, n);
         throw SimulationError(n, -1, "", "rigid step",
                               "step " + std::to_string(n) + ": rigid step failed: " + e.what());
       }
     }
   }
+  assemble_next(nsub, h, n);
+}
 
-  // read back and check the end state
+void Simulation::assemble_next(int nsub, double h, long n) {
+  const Model& m = *model_;
+  StepProfile& prof = profile_;
   State& next = ws_.next;
+  // read back and check the end state
   {
     ScopedTimer t(&prof.check_ms);
     ode_->read_state(&next);
@@ -158,10 +170,9 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
   // (2)+(3) at the end state: its converged magnetization, U*, and the next step's forces
   {
     ScopedTimer t(&prof.sync_ms);
-    place_moments(m, next, &moments_);
+    place_moments(m, next, &moments_, &next.mag);
   }
-  solve_magnetics(true, n);
-  store_magnetization(moments_, &next);
+  solve_magnetics(&next.mag, true, n);
   next.magnetized = true;
   // the load term of the next step's sub-steps: |Σ F_j|/m_b of the forces it starts with
   next.mag_accel.assign(m.nbody, 0.0);
@@ -171,7 +182,21 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
       for (int j = m.body_moment_adr[b]; j < m.body_moment_adr[b] + m.body_moment_num[b]; ++j) F += ws_.F[j];
       next.mag_accel[b] = F.norm() / m.body_mass[b];
     }
-  ws_.audit.magnetic_energy = coenergy();
+  ws_.audit.magnetic_energy = coenergy(next.mag);
+}
+
+void Simulation::commit(long retakes, long unresolved) {
+  profile_.guard_retakes = static_cast<int>(retakes);
+  ws_.audit.guard_retakes += retakes;
+  ws_.audit.guard_unresolved += unresolved;
+  ws_.audit.total.energy_created += ws_.audit.last.energy_created;
+  ws_.audit.total.energy_dissipated += ws_.audit.last.energy_dissipated;
+  if (energy_.substeps == 0)  // the audit's first step: E at its start
+    ws_.audit.initial_total = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
+  std::swap(energy_, ws_.audit);
+  std::swap(state_, ws_.next);
+  ws_.forces_ready = true;  // the forces of assemble_next's solve belong to the new state_
+  inject_body_ = -1;
 }
 
 void Simulation::step() {
@@ -222,19 +247,7 @@ void Simulation::step() {
       rollback();
       nsub = std::min(2 * nsub, o.energy_guard_max_substeps);
     }
-    profile_.guard_retakes = static_cast<int>(retakes);
-    ws_.audit.guard_retakes += retakes;
-    ws_.audit.guard_unresolved += unresolved;
-    ws_.audit.total.energy_created += ws_.audit.last.energy_created;
-    ws_.audit.total.energy_dissipated += ws_.audit.last.energy_dissipated;
-    if (energy_.substeps == 0)  // the audit's first step: E at its start
-      ws_.audit.initial_total = energy_.kinetic + energy_.gravitational + ws_.coenergy_start;
-
-    // commit
-    std::swap(energy_, ws_.audit);
-    std::swap(state_, ws_.next);
-    ws_.forces_ready = true;
-    inject_body_ = -1;
+    commit(retakes, unresolved);
   } catch (const SimulationError&) {
     inject_body_ = -1;
     rollback();

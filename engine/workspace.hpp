@@ -25,11 +25,8 @@ struct Workspace {
   std::vector<Vec3> balance_force;
   std::vector<Vec3> balance_x;
   std::vector<double> balance_w;
-  /// SimOptions::eddy_conductivity (eddy.cpp): each induced moment's flux density in its body's
-  /// frame at the last ODE step (T), that step's length (s; 0 = none yet), and the loss's
-  /// force and torque per body this ODE step (N, N·m; empty when the loss is off)
-  std::vector<Vec3> eddy_B;
-  double eddy_h = 0.0;
+  /// SimOptions::eddy_conductivity (eddy.cpp): the loss's force and torque per body this ODE
+  /// step (N, N·m; empty when the loss is off). Its memory of the last step is State::eddy.
   std::vector<Vec3> eddy_force;
   std::vector<Vec3> eddy_torque;
   /// F, tau and mag.H/J hold the forces of the committed state's poses and magnetization

@@ -19,8 +19,9 @@ namespace magsim::mag {
 namespace {
 
 // Fields at the current state, then g_j = f(H_j)/Ms_j (eq. 10) for the induced moments.
-void picard_image(const MomentSet& set, const DynamicsOptions& opt, MagWorkspace* ws) {
-  compute_fields(set, opt.field, &ws->H, nullptr, &ws->field);
+void picard_image(const MomentDesc& set, const Magnetization& mz, const DynamicsOptions& opt,
+                  MagWorkspace* ws) {
+  compute_fields(set, mz, opt.field, &ws->H, nullptr, &ws->field);
   AndersonHistory& h = ws->anderson;
   const Curve curve = curve_of(Method::Anderson);
   const long k = static_cast<long>(h.idx.size());
@@ -85,40 +86,43 @@ int least_squares(AndersonHistory* h, int depth) {
 }
 
 // Writes the stacked x back into the set: M_j = Ms_j x_j, sub-pairs about it.
-void store(const AndersonHistory& h, MomentSet* set) {
+void store(const AndersonHistory& h, const MomentDesc& set, Magnetization* mz) {
   const long k = static_cast<long>(h.idx.size());
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < k; ++a) {
     const int j = h.idx[a];
-    set->set_magnetization(j, set->Ms[j] * Vec3(h.x[3 * a], h.x[3 * a + 1], h.x[3 * a + 2]));
+    mz->set_magnetization(j, set.Ms[j] * Vec3(h.x[3 * a], h.x[3 * a + 1], h.x[3 * a + 2]),
+                          set.Ms[j]);
   }
 }
 
 }  // namespace
 
-double picard_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws) {
-  compute_fields(*set, opt.field, &ws->H, nullptr, &ws->field);
+double picard_iteration(const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt,
+                        MagWorkspace* ws) {
+  compute_fields(set, *mz, opt.field, &ws->H, nullptr, &ws->field);
   const Curve curve = curve_of(Method::Anderson);
-  const long n = static_cast<long>(set->size());
+  const long n = static_cast<long>(set.size());
   double max_change = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change)
   for (long j = 0; j < n; ++j) {
-    if (set->kind[j] != MomentKind::Induced) continue;
-    const double Ms = set->Ms[j];
-    const Vec3 M_old = set->M[j];
-    set->set_magnetization(j, curve_M(curve, ws->H[j], Ms));  // eq. 10
-    max_change = std::max(max_change, (set->M[j] - M_old).norm() / Ms);
+    if (set.kind[j] != MomentKind::Induced) continue;
+    const double Ms = set.Ms[j];
+    const Vec3 M_old = mz->M[j];
+    mz->set_magnetization(j, curve_M(curve, ws->H[j], Ms), Ms);  // eq. 10
+    max_change = std::max(max_change, (mz->M[j] - M_old).norm() / Ms);
   }
   return max_change;
 }
 
-RelaxStats relax_anderson(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
-                          const std::function<void(int, const MomentSet&)>& on_iteration) {
+RelaxStats relax_anderson(const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt,
+                          MagWorkspace* ws,
+                          const std::function<void(int, const Magnetization&)>& on_iteration) {
   RelaxStats st;
   AndersonHistory& h = ws->anderson;
   h.idx.clear();
-  for (std::size_t j = 0; j < set->size(); ++j)
-    if (set->kind[j] == MomentKind::Induced) h.idx.push_back(static_cast<int>(j));
+  for (std::size_t j = 0; j < set.size(); ++j)
+    if (set.kind[j] == MomentKind::Induced) h.idx.push_back(static_cast<int>(j));
   const int depth = std::max(0, opt.anderson_depth);
   const std::size_t n = 3 * h.idx.size();
   for (auto* v : {&h.x, &h.g, &h.f, &h.x_prev, &h.f_prev}) v->resize(n);
@@ -131,12 +135,12 @@ RelaxStats relax_anderson(MomentSet* set, const DynamicsOptions& opt, MagWorkspa
   h.beta = opt.anderson_damping;
   for (std::size_t a = 0; a < h.idx.size(); ++a) {
     const int j = h.idx[a];
-    for (int c = 0; c < 3; ++c) h.x[3 * a + c] = set->M[j][c] / set->Ms[j];
+    for (int c = 0; c < 3; ++c) h.x[3 * a + c] = mz->M[j][c] / set.Ms[j];
   }
   double f_norm_prev = std::numeric_limits<double>::infinity();
   for (int it = 1; it <= opt.max_iter; ++it) {
     // residual r = g(x) − x at the current iterate (one field evaluation)
-    picard_image(*set, opt, ws);
+    picard_image(set, *mz, opt, ws);
     double f2 = 0, f_max = 0;
     for (std::size_t a = 0; a < h.idx.size(); ++a) {
       double b2 = 0;
@@ -190,11 +194,11 @@ RelaxStats relax_anderson(MomentSet* set, const DynamicsOptions& opt, MagWorkspa
                    dz = v[2] - h.x_prev[3 * a + 2];
       change = std::max(change, std::sqrt(dx * dx + dy * dy + dz * dz));
     }
-    store(h, set);
+    store(h, set, mz);
     st.iterations = it;
     st.last_change = change;
     st.last_residual = f_max;
-    if (on_iteration) on_iteration(it, *set);
+    if (on_iteration) on_iteration(it, *mz);
     // the dynamics' stopping rule (DynamicsOptions::criterion): the residual of the iterate
     // the fields came from, or the change of this step — with the residual too, so that a
     // stalled mixing cannot stop early

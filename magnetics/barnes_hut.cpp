@@ -74,8 +74,8 @@ BarnesHutStats barnes_hut_stats(const FieldWorkspace& ws) {
   return ws.bh ? ws.bh->stats : BarnesHutStats{};
 }
 
-void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
-                       std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
+void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
+                       std::vector<Vec3>* H, std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
   const auto t_start = std::chrono::steady_clock::now();
   const int n = static_cast<int>(set.size());
   H->resize(n);
@@ -86,7 +86,7 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
   ws->nz.resize(n);
   ws->w.resize(n);
   for (int i = 0; i < n; ++i) {
-    const Vec3 m = set.moment(i);
+    const Vec3 m = moment(set, mz, i);
     ws->nz[i] = !(m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0);
     ws->w[i] = set.kind[i] == MomentKind::Induced ? set.volume[i] * set.Ms[i] : m.norm();
   }
@@ -112,7 +112,7 @@ void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vecto
     ws->tree_valid = true;
   }
   const auto t_tree = std::chrono::steady_clock::now();
-  update_multipoles(set, ws);
+  update_multipoles(set, mz, ws);
   const auto t_built = std::chrono::steady_clock::now();
   const double eps2 = opt.softening * opt.softening;
   const float eps2f = static_cast<float>(eps2);

@@ -49,7 +49,11 @@ void barnes_hut_forget_geometry(FieldWorkspace* ws);
 
 /// H (and J) at every moment as compute_fields does, far cells approximated. Called by
 /// compute_fields when the options select Barnes–Hut.
-void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
-                       std::vector<Mat3>* J, BarnesHutWorkspace* ws);
+void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
+                       std::vector<Vec3>* H, std::vector<Mat3>* J, BarnesHutWorkspace* ws);
+inline void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
+                              std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
+  barnes_hut_fields(set, set, opt, H, J, ws);
+}
 
 }  // namespace magsim::mag

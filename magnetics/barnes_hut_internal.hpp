@@ -251,9 +251,9 @@ namespace bh {
 
 /// Sorts the moments along the Morton curve, splits the octree, sets each node's centre and
 /// radius and forms the target groups (the geometry: kept while its keys are unchanged).
-void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspace* ws);
+void build_tree(const MomentDesc& set, const FieldOptions& opt, BarnesHutWorkspace* ws);
 /// This call's moments into the packed sources and every cell's multipole (bottom-up).
-void update_multipoles(const MomentSet& set, BarnesHutWorkspace* ws);
+void update_multipoles(const MomentDesc& set, const Magnetization& mz, BarnesHutWorkspace* ws);
 
 // ---- barnes_hut_lists.cpp ---------------------------------------------------------------
 

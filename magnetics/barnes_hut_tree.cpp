@@ -170,7 +170,7 @@ void cell_fields(const Node& nd, double* f) {
   f[kTz] = f[kOxxz] + f[kOyyz] + f[kOzzz];
 }
 
-void close_group(const MomentSet& set, BarnesHutWorkspace* ws, int t0, int t1) {
+void close_group(const MomentDesc& set, BarnesHutWorkspace* ws, int t0, int t1) {
   if (t1 <= t0) return;
   Group g;
   g.t0 = t0;
@@ -192,7 +192,7 @@ void close_group(const MomentSet& set, BarnesHutWorkspace* ws, int t0, int t1) {
 
 // A subtree of at most G moments is one group; below a larger node, consecutive children
 // of at most G moments each are packed together up to G.
-void make_groups(const MomentSet& set, BarnesHutWorkspace* ws, int id, int G) {
+void make_groups(const MomentDesc& set, BarnesHutWorkspace* ws, int id, int G) {
   const Node nd = ws->nodes[id];
   if (nd.t1 - nd.t0 <= G || nd.child < 0) {
     close_group(set, ws, nd.t0, nd.t1);
@@ -219,7 +219,7 @@ void make_groups(const MomentSet& set, BarnesHutWorkspace* ws, int id, int G) {
 // Which moments belong to a body (group ≥ 0) of several moments. Only those can bring a
 // target's own body into a far cell: a cell accepted for a group of targets lies outside
 // the targets' bounding sphere, so it never holds a target itself (a one-moment body).
-void find_shared(const MomentSet& set, BarnesHutWorkspace* ws) {
+void find_shared(const MomentDesc& set, BarnesHutWorkspace* ws) {
   const std::size_t n = set.size();
   ws->shared.assign(n, 0);
   std::int32_t gmax = -1;
@@ -245,7 +245,7 @@ void find_shared(const MomentSet& set, BarnesHutWorkspace* ws) {
 
 // The geometry: Morton order, octree, node centres and radii, target groups. Depends on the
 // positions, groups, which moments are nonzero, and the leaf and group sizes only.
-void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspace* ws) {
+void build_tree(const MomentDesc& set, const FieldOptions& opt, BarnesHutWorkspace* ws) {
   const int n = static_cast<int>(set.size());
   find_shared(set, ws);
   // Morton codes on the bounding cube, sorted (ties by index: deterministic)
@@ -314,11 +314,11 @@ void build_tree(const MomentSet& set, const FieldOptions& opt, BarnesHutWorkspac
 }
 
 // The moments of this call: sources' moments, multipoles bottom-up, the kernel's cells.
-void update_multipoles(const MomentSet& set, BarnesHutWorkspace* ws) {
+void update_multipoles(const MomentDesc& set, const Magnetization& mz, BarnesHutWorkspace* ws) {
   detail::SourceBuffer& s = ws->src;
   const int ns = static_cast<int>(s.size());
   for (int k = 0; k < ns; ++k) {
-    const Vec3 m = set.moment(static_cast<std::size_t>(s.id[k]));
+    const Vec3 m = moment(set, mz, static_cast<std::size_t>(s.id[k]));
     s.mx[k] = m.x(); s.my[k] = m.y(); s.mz[k] = m.z();
   }
   // float copies for the float near field's gather (cheap; done whatever the options)

@@ -20,13 +20,14 @@ double curve_energy_density(Curve c, double Mnorm, double Ms) {
 }
 
 // U* = μ0 Σ_induced V Ψ(M) − ½ μ0 Σ m·(H − H0) − μ0 Σ m·H0
-double magnetic_coenergy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H) {
+double magnetic_coenergy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                         const std::vector<Vec3>& H) {
   if (H.size() != set.size()) return 0.0;
   double stored = 0.0, pairs = 0.0, uniform = 0.0;
   for (std::size_t j = 0; j < set.size(); ++j) {
-    const Vec3 mj = set.moment(j);
+    const Vec3 mj = moment(set, mz, j);
     if (set.kind[j] == MomentKind::Induced)
-      stored += set.volume[j] * curve_energy_density(curve, set.M[j].norm(), set.Ms[j]);
+      stored += set.volume[j] * curve_energy_density(curve, mz.M[j].norm(), set.Ms[j]);
     pairs += mj.dot(H[j] - set.H0);
     uniform += mj.dot(set.H0);
   }

@@ -26,6 +26,10 @@ double curve_energy_density(Curve c, double Mnorm, double Ms);
 /// U* (J) of the moments in `set` given H_j, the field at each moment (H0 included, as
 /// compute_fields returns it). Same-body pairs are included (constant for rigid bodies of
 /// permanent moments). Returns 0 when H does not match the set (no field evaluated yet).
-double magnetic_coenergy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H);
+double magnetic_coenergy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                         const std::vector<Vec3>& H);
+inline double magnetic_coenergy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H) {
+  return magnetic_coenergy(set, set, curve, H);
+}
 
 }  // namespace magsim::mag

@@ -77,7 +77,7 @@ std::string validate(const FieldOptions& o) {
   return e.str();
 }
 
-bool pairs_bounded(const MomentSet& set, const FieldOptions& opt) {
+bool pairs_bounded(const MomentDesc& set, const FieldOptions& opt) {
   if (!opt.bounded_pairs) return false;
   for (double a : set.radius)
     if (a > 0) return true;
@@ -137,10 +137,11 @@ constexpr std::size_t kChunk = 4096;
 // Targets per block (the unit of work of a thread).
 constexpr long kTargetBlock = 32;
 
-void pack_sources(const MomentSet& set, const FieldOptions& opt, FieldWorkspace* ws) {
+void pack_sources(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
+                  FieldWorkspace* ws) {
   ws->src.clear();
   for (std::size_t i = 0; i < set.size(); ++i) {
-    const Vec3 m = set.moment(i);
+    const Vec3 m = moment(set, mz, i);
     if (m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0) continue;
     const Vec3& p = set.position[i];
     ws->src.push(p.x(), p.y(), p.z(), m.x(), m.y(), m.z(), static_cast<double>(i), set.group[i],
@@ -150,7 +151,7 @@ void pack_sources(const MomentSet& set, const FieldOptions& opt, FieldWorkspace*
   ws->bounded = pairs_bounded(set, opt);
 }
 
-detail::Target target_of(const MomentSet& set, std::size_t j) {
+detail::Target target_of(const MomentDesc& set, std::size_t j) {
   const Vec3& p = set.position[j];
   const double g = set.group[j] >= 0 ? static_cast<double>(set.group[j])
                                      : std::numeric_limits<double>::quiet_NaN();
@@ -158,7 +159,7 @@ detail::Target target_of(const MomentSet& set, std::size_t j) {
 }
 
 // The direct sum at targets idx[0..nt) (or 0..nt when idx is null), H0 added.
-void direct_sum(const MomentSet& set, const FieldOptions& opt, const FieldWorkspace& ws,
+void direct_sum(const MomentDesc& set, const FieldOptions& opt, const FieldWorkspace& ws,
                 const int* idx, long nt, Vec3* H, Mat3* J) {
   const double eps2 = opt.softening * opt.softening;
   const std::size_t ns = ws.src.size();
@@ -190,27 +191,27 @@ void direct_sum(const MomentSet& set, const FieldOptions& opt, const FieldWorksp
 
 }  // namespace
 
-void compute_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
-                    std::vector<Mat3>* J, FieldWorkspace* ws) {
+void compute_fields(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
+                    std::vector<Vec3>* H, std::vector<Mat3>* J, FieldWorkspace* ws) {
   const long n = static_cast<long>(set.size());
   H->resize(n);
   if (J) J->resize(n);
   if (resolve_solver(opt, set.size()) == FieldSolver::BarnesHut) {
     if (!ws->bh) ws->bh.reset(new_barnes_hut_workspace());
-    barnes_hut_fields(set, opt, H, J, ws->bh.get());
+    barnes_hut_fields(set, mz, opt, H, J, ws->bh.get());
     return;
   }
-  pack_sources(set, opt, ws);
+  pack_sources(set, mz, opt, ws);
   direct_sum(set, opt, *ws, nullptr, n, H->data(), J ? J->data() : nullptr);
 }
 
-void compute_fields_at(const MomentSet& set, const FieldOptions& opt,
+void compute_fields_at(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
                        const std::vector<int>& targets, std::vector<Vec3>* H,
                        std::vector<Mat3>* J, FieldWorkspace* ws) {
   const long nt = static_cast<long>(targets.size());
   H->resize(nt);
   if (J) J->resize(nt);
-  pack_sources(set, opt, ws);
+  pack_sources(set, mz, opt, ws);
   direct_sum(set, opt, *ws, targets.data(), nt, H->data(), J ? J->data() : nullptr);
 }
 

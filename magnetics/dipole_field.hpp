@@ -123,7 +123,7 @@ Mat3 dipole_jacobian(const Vec3& r, const Vec3& m, double eps2 = 0.0);
 Vec3 bounded_separation(const Vec3& r, double R);
 /// True when compute_fields sums `set` as bounded pairs (the option is on and some moment
 /// has a radius > 0).
-bool pairs_bounded(const MomentSet& set, const FieldOptions& opt);
+bool pairs_bounded(const MomentDesc& set, const FieldOptions& opt);
 
 /// H_j = H0 + Σ_{i≠j} h(p_j − p_i, m_i) at every moment j (A/m). With J != nullptr also
 /// J_j = ∂H_j/∂p_j with the sources held fixed, summed over sources in other groups only
@@ -131,14 +131,23 @@ bool pairs_bounded(const MomentSet& set, const FieldOptions& opt);
 /// skipped. Threaded over targets (OpenMP); the sum order is fixed, so results are
 /// deterministic (for the direct sum and Barnes–Hut alike, whatever the thread count).
 /// opt.solver picks the direct sum or the Barnes–Hut approximation.
-void compute_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
-                    std::vector<Mat3>* J, FieldWorkspace* ws);
+void compute_fields(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
+                    std::vector<Vec3>* H, std::vector<Mat3>* J, FieldWorkspace* ws);
+inline void compute_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
+                           std::vector<Mat3>* J, FieldWorkspace* ws) {
+  compute_fields(set, set, opt, H, J, ws);
+}
 
 /// The direct sum of compute_fields at the listed moments only (H, J sized like targets).
 /// Used to measure Barnes–Hut errors and to time the direct kernel on a sample of targets.
-void compute_fields_at(const MomentSet& set, const FieldOptions& opt,
+void compute_fields_at(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
                        const std::vector<int>& targets, std::vector<Vec3>* H,
                        std::vector<Mat3>* J, FieldWorkspace* ws);
+inline void compute_fields_at(const MomentSet& set, const FieldOptions& opt,
+                              const std::vector<int>& targets, std::vector<Vec3>* H,
+                              std::vector<Mat3>* J, FieldWorkspace* ws) {
+  compute_fields_at(set, set, opt, targets, H, J, ws);
+}
 
 /// The solver compute_fields uses for n moments under opt (Auto resolved).
 FieldSolver resolve_solver(const FieldOptions& opt, std::size_t n);

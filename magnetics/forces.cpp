@@ -32,8 +32,8 @@ namespace {
 //   τ_j = μ0 m_j × (H_j − H_j^same) (permanent),  τ_j = −μ0 m_j × H_j^same (induced),
 // H^same the field of the moment's own group, summed here as compute_fields sums a pair
 // (softened, bounded pairs clamped). Groups of one moment keep τ as it is.
-void same_body_torques(const MomentSet& set, const FieldOptions& field, MagWorkspace* ws,
-                       std::vector<Vec3>* tau) {
+void same_body_torques(const MomentDesc& set, const Magnetization& mz, const FieldOptions& field,
+                       MagWorkspace* ws, std::vector<Vec3>* tau) {
   std::vector<int>& order = ws->group_order;
   order.clear();
   for (std::size_t j = 0; j < set.size(); ++j)
@@ -53,9 +53,9 @@ void same_body_torques(const MomentSet& set, const FieldOptions& field, MagWorks
         if (i == j) continue;
         const Vec3 r = set.position[j] - set.position[i];
         const Vec3 rb = bounded ? bounded_separation(r, set.radius[i] + set.radius[j]) : r;
-        Hs += dipole_field(rb, set.moment(i), eps2);
+        Hs += dipole_field(rb, moment(set, mz, i), eps2);
       }
-      const Vec3 m = set.moment(j);
+      const Vec3 m = moment(set, mz, j);
       (*tau)[j] = set.kind[j] == MomentKind::Permanent ? Vec3(kMu0 * m.cross(ws->H[j] - Hs))
                                                        : Vec3(-kMu0 * m.cross(Hs));
     }
@@ -69,8 +69,8 @@ void same_body_torques(const MomentSet& set, const FieldOptions& field, MagWorks
 // along r there) and its tangential part is scaled by R/|r|. compute_fields sums J(r_b)
 // (sum_pairs); this adds μ0 (P − I) J(r_b) m_j for each pair of different groups inside its
 // bound. The pairs are found on a grid of cells of 2 max_j a_j (one cell's 27 neighbours).
-void bounded_pair_forces(const MomentSet& set, const FieldOptions& field, MagWorkspace* ws,
-                         std::vector<Vec3>* F) {
+void bounded_pair_forces(const MomentDesc& set, const Magnetization& mz, const FieldOptions& field,
+                         MagWorkspace* ws, std::vector<Vec3>* F) {
   const std::size_t n = set.size();
   double amax = 0.0;
   for (double a : set.radius) amax = std::max(amax, a);
@@ -89,7 +89,7 @@ void bounded_pair_forces(const MomentSet& set, const FieldOptions& field, MagWor
   std::sort(cells.begin(), cells.end());
   for (const auto& [kj, j] : cells) {
     (void)kj;
-    const Vec3 mj = set.moment(j);
+    const Vec3 mj = moment(set, mz, j);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
@@ -103,7 +103,7 @@ void bounded_pair_forces(const MomentSet& set, const FieldOptions& field, MagWor
             if (!(d < R && d > 0.0)) continue;
             const Vec3 u = r / d;
             const Mat3 P = (R / d) * (Mat3::Identity() - u * u.transpose());
-            const Vec3 Jm = dipole_jacobian(u * R, set.moment(i), eps2) * mj;
+            const Vec3 Jm = dipole_jacobian(u * R, moment(set, mz, i), eps2) * mj;
             (*F)[j] += kMu0 * (P * Jm - Jm);
           }
         }
@@ -112,13 +112,14 @@ void bounded_pair_forces(const MomentSet& set, const FieldOptions& field, MagWor
 
 }  // namespace
 
-void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
-                    const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
+void compute_forces(const MomentDesc& set, const Magnetization& mz, ForceModel model,
+                    Curve curve, const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
                     std::vector<Vec3>* tau, std::vector<Vec3>* F_classic,
                     bool reaction_symmetric, double total_tol, int total_max_iter) {
-  compute_fields(set, field, &ws->H, &ws->J, &ws->field);
+  compute_fields(set, mz, field, &ws->H, &ws->J, &ws->field);
   if (model == ForceModel::ZeemanTotal) {
-    detail::zeeman_total_forces(set, curve, field, ws, F, tau, F_classic, total_tol, total_max_iter);
+    detail::zeeman_total_forces(set, mz, curve, field, ws, F, tau, F_classic, total_tol,
+                                total_max_iter);
     return;
   }
   const long n = static_cast<long>(set.size());
@@ -129,7 +130,7 @@ void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
   for (long j = 0; j < n; ++j) {
     const Vec3& H = ws->H[j];
     const Mat3& J = ws->J[j];
-    const Vec3 m = set.moment(j);
+    const Vec3 m = moment(set, mz, j);
     const Vec3 Fc = classic_force(m, J);
     if (F_classic) (*F_classic)[j] = Fc;
     if (set.kind[j] == MomentKind::Permanent) {
@@ -137,25 +138,27 @@ void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
       if (tau) (*tau)[j] = kMu0 * m.cross(H);  // τ = μ0 m × H
     } else {
       (*F)[j] = model == ForceModel::Zeeman
-                    ? zeeman_force(curve, set.volume[j], set.Ms[j], set.M[j], H, J)
+                    ? zeeman_force(curve, set.volume[j], set.Ms[j], mz.M[j], H, J)
                     : Fc;
       if (tau) (*tau)[j] = Vec3::Zero();
     }
   }
-  if (model == ForceModel::Classic && pairs_bounded(set, field)) bounded_pair_forces(set, field, ws, F);
-  if (model == ForceModel::Classic && tau) same_body_torques(set, field, ws, tau);
+  if (model == ForceModel::Classic && pairs_bounded(set, field))
+    bounded_pair_forces(set, mz, field, ws, F);
+  if (model == ForceModel::Classic && tau) same_body_torques(set, mz, field, ws, tau);
   if (!(reaction_symmetric && model == ForceModel::Zeeman)) return;
   // the effective moments m̃_j = V_j [A_j(2M_j + H_j) + M_j] as sources (scratch set reused)
   MomentSet& eff = ws->effective;
-  eff = set;
+  eff.assign(set, mz);
   for (long j = 0; j < n; ++j) {
     if (set.kind[j] != MomentKind::Induced) continue;
     const Mat3 A = curve_dMdH(curve, ws->H[j], set.Ms[j]);
-    eff.M[j] = zeeman_effective_magnetization(A, set.M[j], ws->H[j]);
+    eff.M[j] = zeeman_effective_magnetization(A, mz.M[j], ws->H[j]);
   }
   compute_fields(eff, field, &ws->H_eff_src, &ws->J_eff_src, &ws->field);
   // F_j = ½ (F_zeeman,j + μ0 J̃_j m_j)
-  for (long j = 0; j < n; ++j) (*F)[j] = 0.5 * ((*F)[j] + classic_force(set.moment(j), ws->J_eff_src[j]));
+  for (long j = 0; j < n; ++j)
+    (*F)[j] = 0.5 * ((*F)[j] + classic_force(moment(set, mz, j), ws->J_eff_src[j]));
   if (!tau) return;
   // the torque of a permanent moment from the same pair energy
   //   U_ij = −½ μ0 [m̃_j·H_i(m_i) + m_j·H_i(m̃_i)],  m̃ = m for permanent moments:
@@ -165,7 +168,7 @@ void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
   // off across the ground: 432 balls, 1 s, final KE 0.55 J → 0.27 J with this torque.
   for (long j = 0; j < n; ++j)
     if (set.kind[j] == MomentKind::Permanent)
-      (*tau)[j] = 0.5 * kMu0 * set.moment(j).cross(ws->H[j] + ws->H_eff_src[j]);
+      (*tau)[j] = 0.5 * kMu0 * moment(set, mz, j).cross(ws->H[j] + ws->H_eff_src[j]);
 }
 
 }  // namespace magsim::mag

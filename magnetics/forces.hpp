@@ -74,20 +74,37 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// iteration is one field evaluation. Statistics in ws->total. reaction_symmetric is
 /// ignored (momentum is conserved already). Same-body pairs (one group) add no force, as for
 /// the other models.
-void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
-                    const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
-                    std::vector<Vec3>* tau, std::vector<Vec3>* F_classic = nullptr,
-                    bool reaction_symmetric = false, double total_tol = 1e-4,
-                    int total_max_iter = 100);
+void compute_forces(const MomentDesc& set, const Magnetization& mz, ForceModel model,
+                    Curve curve, const FieldOptions& field, MagWorkspace* ws,
+                    std::vector<Vec3>* F, std::vector<Vec3>* tau,
+                    std::vector<Vec3>* F_classic = nullptr, bool reaction_symmetric = false,
+                    double total_tol = 1e-4, int total_max_iter = 100);
+inline void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
+                           const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
+                           std::vector<Vec3>* tau, std::vector<Vec3>* F_classic = nullptr,
+                           bool reaction_symmetric = false, double total_tol = 1e-4,
+                           int total_max_iter = 100) {
+  compute_forces(set, set, model, curve, field, ws, F, tau, F_classic, reaction_symmetric,
+                 total_tol, total_max_iter);
+}
 
 /// E_sys of ForceModel::ZeemanTotal at the magnetizations in `set` (the equilibrium ones:
 /// the force is its gradient there). J.
-double zeeman_total_energy(const MomentSet& set, Curve curve, const FieldOptions& field,
-                           FieldWorkspace* ws);
+double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                           const FieldOptions& field, FieldWorkspace* ws);
+inline double zeeman_total_energy(const MomentSet& set, Curve curve, const FieldOptions& field,
+                                  FieldWorkspace* ws) {
+  return zeeman_total_energy(set, set, curve, field, ws);
+}
 /// The same from fields already evaluated: H at every moment, Hp the permanent moments' own
 /// field (with H0) at the permanent moments perm (ws->total.perm and .Hp after a
 /// ZeemanTotal force evaluation).
-double zeeman_total_energy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H,
-                           const std::vector<int>& perm, const std::vector<Vec3>& Hp);
+double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                           const std::vector<Vec3>& H, const std::vector<int>& perm,
+                           const std::vector<Vec3>& Hp);
+inline double zeeman_total_energy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H,
+                                  const std::vector<int>& perm, const std::vector<Vec3>& Hp) {
+  return zeeman_total_energy(set, set, curve, H, perm, Hp);
+}
 
 }  // namespace magsim::mag

@@ -55,11 +55,11 @@ void apply_S(const std::vector<Vec3>& u, const FieldOptions& field, MagWorkspace
 }  // namespace
 
 // (forces_total.hpp)
-void permanent_field(const MomentSet& set, const FieldOptions& field, MomentSet* scratch,
-                     std::vector<int>* perm, std::vector<Vec3>* Hp, std::vector<Mat3>* Jp,
-                     FieldWorkspace* ws) {
+void permanent_field(const MomentDesc& set, const Magnetization& mz, const FieldOptions& field,
+                     MomentSet* scratch, std::vector<int>* perm, std::vector<Vec3>* Hp,
+                     std::vector<Mat3>* Jp, FieldWorkspace* ws) {
   perm->clear();
-  *scratch = set;
+  scratch->assign(set, mz);
   for (std::size_t j = 0; j < set.size(); ++j) {
     if (set.kind[j] == MomentKind::Induced)
       scratch->M[j] = Vec3::Zero();
@@ -69,9 +69,10 @@ void permanent_field(const MomentSet& set, const FieldOptions& field, MomentSet*
   if (!perm->empty()) compute_fields_at(*scratch, field, *perm, Hp, Jp, ws);
 }
 
-void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& field,
-                         MagWorkspace* ws, std::vector<Vec3>* F, std::vector<Vec3>* tau,
-                         std::vector<Vec3>* F_classic, double tol, int max_iter) {
+void zeeman_total_forces(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                         const FieldOptions& field, MagWorkspace* ws, std::vector<Vec3>* F,
+                         std::vector<Vec3>* tau, std::vector<Vec3>* F_classic, double tol,
+                         int max_iter) {
   ZeemanTotalScratch& t = ws->total;
   const std::size_t n = set.size();
   t.idx.clear();
@@ -81,7 +82,7 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
   if (t.w.size() != k) t.w.assign(k, Vec3::Zero());  // no warm start across a change of set
 
   // the sources of the adjoint field: induced moments only, no uniform field
-  t.src = set;
+  t.src.assign(set, mz);
   t.src.H0 = Vec3::Zero();
   for (std::size_t j = 0; j < n; ++j)
     if (set.kind[j] == MomentKind::Permanent) t.src.m_perm[j] = Vec3::Zero();
@@ -92,7 +93,7 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
   for (std::size_t a = 0; a < k; ++a) {
     const int j = t.idx[a];
     const Mat3 A = curve_dMdH(curve, ws->H[j], set.Ms[j]);
-    t.mt[a] = set.volume[j] * zeeman_effective_magnetization(A, set.M[j], ws->H[j]);
+    t.mt[a] = set.volume[j] * zeeman_effective_magnetization(A, mz.M[j], ws->H[j]);
     t.B[a] = sqrt_psd(set.volume[j] * 0.5 * (A + A.transpose()));
   }
 
@@ -137,13 +138,13 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
   compute_fields(t.src, field, &t.Hs, &t.Js, &ws->field);
 
   // the permanent moments' own field (with H0) at the permanent moments
-  permanent_field(set, field, &ws->effective, &t.perm, &t.Hp, &t.Jp, &ws->field);
+  permanent_field(set, mz, field, &ws->effective, &t.perm, &t.Hp, &t.Jp, &ws->field);
 
   F->resize(n);
   if (tau) tau->resize(n);
   if (F_classic) F_classic->resize(n);
   for (std::size_t j = 0; j < n; ++j) {
-    const Vec3 m = set.moment(j);
+    const Vec3 m = moment(set, mz, j);
     if (F_classic) (*F_classic)[j] = classic_force(m, ws->J[j]);
     if (tau) (*tau)[j] = Vec3::Zero();
   }
@@ -151,12 +152,12 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
   for (std::size_t a = 0; a < k; ++a) {
     const int j = t.idx[a];
     const Vec3 lam = set.volume[j] * t.src.M[j];
-    (*F)[j] = kMu0 * (ws->J[j].transpose() * lam + t.Js[j].transpose() * set.moment(j));
+    (*F)[j] = kMu0 * (ws->J[j].transpose() * lam + t.Js[j].transpose() * moment(set, mz, j));
   }
   // F_p = μ0 (J̃_p + J^perm_p)ᵀ m_p,  τ_p = μ0 m_p × (H̃_p + H^perm_p)
   for (std::size_t a = 0; a < t.perm.size(); ++a) {
     const int p = t.perm[a];
-    const Vec3 m = set.moment(p);
+    const Vec3 m = moment(set, mz, p);
     (*F)[p] = kMu0 * ((t.Js[p] + t.Jp[a]).transpose() * m);
     if (tau) (*tau)[p] = kMu0 * m.cross(t.Hs[p] + t.Hp[a]);
   }
@@ -166,27 +167,28 @@ void zeeman_total_forces(const MomentSet& set, Curve curve, const FieldOptions& 
 
 // E_sys = Σ_{i induced} e_i(H_i) + U_pp (forces.hpp), from the field at every moment and
 // the permanent moments' own field Hp at the permanent moments perm
-double zeeman_total_energy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H,
-                           const std::vector<int>& perm, const std::vector<Vec3>& Hp) {
+double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                           const std::vector<Vec3>& H, const std::vector<int>& perm,
+                           const std::vector<Vec3>& Hp) {
   double E = 0.0;
   for (std::size_t j = 0; j < set.size(); ++j)
     if (set.kind[j] == MomentKind::Induced) E += zeeman_energy(curve, set.volume[j], set.Ms[j], H[j]);
   // U_pp = −μ0 [½ Σ_p m_p·(H^perm_p − H0) + Σ_p m_p·H0]
   for (std::size_t a = 0; a < perm.size(); ++a) {
-    const Vec3 m = set.moment(perm[a]);
+    const Vec3 m = moment(set, mz, perm[a]);
     E -= kMu0 * (0.5 * m.dot(Hp[a] - set.H0) + m.dot(set.H0));
   }
   return E;
 }
 
-double zeeman_total_energy(const MomentSet& set, Curve curve, const FieldOptions& field,
-                           FieldWorkspace* ws) {
+double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                           const FieldOptions& field, FieldWorkspace* ws) {
   std::vector<Vec3> H, Hp;
-  compute_fields(set, field, &H, nullptr, ws);
+  compute_fields(set, mz, field, &H, nullptr, ws);
   MomentSet scratch;
   std::vector<int> perm;
-  detail::permanent_field(set, field, &scratch, &perm, &Hp, nullptr, ws);
-  return zeeman_total_energy(set, curve, H, perm, Hp);
+  detail::permanent_field(set, mz, field, &scratch, &perm, &Hp, nullptr, ws);
+  return zeeman_total_energy(set, mz, curve, H, perm, Hp);
 }
 
 }  // namespace magsim::mag

@@ -21,7 +21,7 @@ struct Problem {
   Eigen::MatrixXd T;      // (3k × 3k) induced–induced interaction (times volume)
 };
 
-Problem build(const MomentSet& set, const FieldOptions& field) {
+Problem build(const MomentDesc& set, const FieldOptions& field) {
   Problem P;
   for (std::size_t j = 0; j < set.size(); ++j)
     if (set.kind[j] == MomentKind::Induced) P.idx.push_back(static_cast<int>(j));
@@ -58,7 +58,7 @@ Problem build(const MomentSet& set, const FieldOptions& field) {
   return P;
 }
 
-Eigen::VectorXd residual(const MomentSet& set, const Problem& P, Curve curve,
+Eigen::VectorXd residual(const MomentDesc& set, const Problem& P, Curve curve,
                          const Eigen::VectorXd& M, Eigen::VectorXd* H) {
   *H = P.Hb + P.T * M;
   Eigen::VectorXd R(M.size());
@@ -71,18 +71,19 @@ Eigen::VectorXd residual(const MomentSet& set, const Problem& P, Curve curve,
 
 }  // namespace
 
-ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field, double rel_tol,
-                       int max_steps, const std::function<void(int, double)>& on_step) {
+ExactStats solve_exact(const MomentDesc& set, Magnetization* mz, Curve curve,
+                       const FieldOptions& field, double rel_tol, int max_steps,
+                       const std::function<void(int, double)>& on_step) {
   ExactStats st;
-  const Problem P = build(*set, field);
+  const Problem P = build(set, field);
   const int k = static_cast<int>(P.idx.size());
   if (k == 0) {
     st.converged = true;
     return st;
   }
   Eigen::VectorXd M(3 * k), H;
-  for (int a = 0; a < k; ++a) M.segment<3>(3 * a) = set->M[P.idx[a]];
-  Eigen::VectorXd R = residual(*set, P, curve, M, &H);
+  for (int a = 0; a < k; ++a) M.segment<3>(3 * a) = mz->M[P.idx[a]];
+  Eigen::VectorXd R = residual(set, P, curve, M, &H);
   auto rel = [&](const Eigen::VectorXd& r, const Eigen::VectorXd& m) {
     const double mn = m.norm();
     return mn > 0 ? r.norm() / mn : r.norm();
@@ -97,7 +98,7 @@ ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field, d
     // Newton matrix I − A T
     Jac = -P.T;
     for (int a = 0; a < k; ++a) {
-      const Mat3 A = curve_dMdH(curve, H.segment<3>(3 * a), set->Ms[P.idx[a]]);
+      const Mat3 A = curve_dMdH(curve, H.segment<3>(3 * a), set.Ms[P.idx[a]]);
       Jac.middleRows<3>(3 * a) = A * Jac.middleRows<3>(3 * a);
     }
     Jac += Eigen::MatrixXd::Identity(3 * k, 3 * k);
@@ -108,7 +109,7 @@ ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field, d
     Eigen::VectorXd Mn, Hn, Rn;
     for (int ls = 0; ls < 40; ++ls) {
       Mn = M + lam * delta;
-      Rn = residual(*set, P, curve, Mn, &Hn);
+      Rn = residual(set, P, curve, Mn, &Hn);
       if (Rn.norm() < (1.0 - 1e-4 * lam) * r0 || Rn.norm() == 0.0) break;
       lam *= 0.5;
     }
@@ -123,8 +124,8 @@ ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field, d
   for (int a = 0; a < k; ++a) {
     const int j = P.idx[a];
     const Vec3 Mj = M.segment<3>(3 * a);
-    if (Mj.norm() <= set->Ms[j]) set->set_magnetization(j, Mj);
-    else set->M[j] = Mj;  // cannot happen for a converged solve: f saturates at Ms
+    if (Mj.norm() <= set.Ms[j]) mz->set_magnetization(j, Mj, set.Ms[j]);
+    else mz->M[j] = Mj;  // cannot happen for a converged solve: f saturates at Ms
   }
   return st;
 }

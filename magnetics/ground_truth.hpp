@@ -20,9 +20,14 @@ struct ExactStats {
 /// Dense: use for up to a few thousand induced moments.
 /// `on_step(k, residual)` (optional) is called after Newton step k = 1, 2, … (progress of
 /// long solves: a step of 3000 induced moments factors a dense 9000 x 9000 matrix).
-ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field,
-                       double rel_tol = 1e-12, int max_steps = 60,
+ExactStats solve_exact(const MomentDesc& set, Magnetization* mz, Curve curve,
+                       const FieldOptions& field, double rel_tol = 1e-12, int max_steps = 60,
                        const std::function<void(int, double)>& on_step = {});
+inline ExactStats solve_exact(MomentSet* set, Curve curve, const FieldOptions& field,
+                              double rel_tol = 1e-12, int max_steps = 60,
+                              const std::function<void(int, double)>& on_step = {}) {
+  return solve_exact(*set, set, curve, field, rel_tol, max_steps, on_step);
+}
 
 /// eq. 12: e_M = ‖M_gt − M‖ / ‖M_gt‖ over the stacked induced magnetizations.
 double magnetization_error(const MomentSet& set, const std::vector<Vec3>& M_gt);

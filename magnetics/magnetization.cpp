@@ -196,52 +196,54 @@ void update_pair(Method method, const DynamicsOptions& opt, double Ms, const Vec
   keep_pair_apart(Ms, opt.min_pair_angle, M1, M2);
 }
 
-SweepStats magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws) {
+SweepStats magnetization_iteration(const MomentDesc& set, Magnetization* mz,
+                                   const DynamicsOptions& opt, MagWorkspace* ws) {
   if (opt.method == Method::Anderson) {
     // a Picard step sets M = f(H): its change is the residual of the previous iterate
-    const double c = picard_iteration(set, opt, ws);
+    const double c = picard_iteration(set, mz, opt, ws);
     return {c, c};
   }
-  compute_fields(*set, opt.field, &ws->H, nullptr, &ws->field);
-  const long n = static_cast<long>(set->size());
+  compute_fields(set, *mz, opt.field, &ws->H, nullptr, &ws->field);
+  const long n = static_cast<long>(set.size());
   const Curve curve = curve_of(opt.method);
   double max_change = 0.0, max_res = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change, max_res)
   for (long j = 0; j < n; ++j) {
-    if (set->kind[j] != MomentKind::Induced) continue;
-    const double Ms = set->Ms[j];
+    if (set.kind[j] != MomentKind::Induced) continue;
+    const double Ms = set.Ms[j];
     const Vec3& H = ws->H[j];
-    Vec3& M1 = set->M1[j];
-    Vec3& M2 = set->M2[j];
-    if (!set->seeded[j]) {
+    Vec3& M1 = mz->M1[j];
+    Vec3& M2 = mz->M2[j];
+    if (!mz->seeded[j]) {
       // a new, unmagnetized moment: M1 = −M2, the pair axis ⊥ the field it feels
       const double hn = H.norm();
       const Vec3 w = hn > 0 ? any_perpendicular(H / hn) : Vec3(Vec3::UnitX());
       M1 = Ms * w;
       M2 = -Ms * w;
-      set->seeded[j] = 1;
+      mz->seeded[j] = 1;
     }
-    const Vec3 M_old = set->M[j];
+    const Vec3 M_old = mz->M[j];
     max_res = std::max(max_res, (M_old - curve_M(curve, H, Ms)).norm() / Ms);
     const Vec3 Heff = effective_field(opt.method, opt, H, M_old, Ms);
     update_pair(opt.method, opt, Ms, Heff, &M1, &M2);
     const Vec3 M_new = 0.5 * (M1 + M2);
-    set->M[j] = M_new;
+    mz->M[j] = M_new;
     max_change = std::max(max_change, (M_new - M_old).norm() / Ms);
   }
   return {max_change, max_res};
 }
 
-RelaxStats relax_magnetization(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
-                               const std::function<void(int, const MomentSet&)>& on_iteration) {
-  if (opt.method == Method::Anderson) return relax_anderson(set, opt, ws, on_iteration);
+RelaxStats relax_magnetization(
+    const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt, MagWorkspace* ws,
+    const std::function<void(int, const Magnetization&)>& on_iteration) {
+  if (opt.method == Method::Anderson) return relax_anderson(set, mz, opt, ws, on_iteration);
   RelaxStats st;
   for (int k = 1; k <= opt.max_iter; ++k) {
-    const SweepStats sw = magnetization_iteration(set, opt, ws);
+    const SweepStats sw = magnetization_iteration(set, mz, opt, ws);
     st.last_change = sw.change;
     st.last_residual = sw.residual;
     st.iterations = k;
-    if (on_iteration) on_iteration(k, *set);
+    if (on_iteration) on_iteration(k, *mz);
     const double crit =
         opt.criterion == DynamicsOptions::Criterion::Residual ? sw.residual : sw.change;
     if (crit < opt.tol) {
@@ -250,6 +252,13 @@ RelaxStats relax_magnetization(MomentSet* set, const DynamicsOptions& opt, MagWo
     }
   }
   return st;
+}
+
+RelaxStats relax_magnetization(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
+                               const std::function<void(int, const MomentSet&)>& on_iteration) {
+  std::function<void(int, const Magnetization&)> on_sweep;
+  if (on_iteration) on_sweep = [&](int k, const Magnetization&) { on_iteration(k, *set); };
+  return relax_magnetization(*set, set, opt, ws, on_sweep);
 }
 
 }  // namespace magsim::mag

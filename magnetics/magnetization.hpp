@@ -119,12 +119,21 @@ struct SweepStats {
 /// and the residual of the iterate before it.
 /// Fields are left in ws->H (they belong to the iterate *before* the update).
 /// Method::Anderson has no history here: its sweep is the plain Picard step M ← f(H(M)).
-SweepStats magnetization_iteration(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws);
+SweepStats magnetization_iteration(const MomentDesc& set, Magnetization* mz,
+                                   const DynamicsOptions& opt, MagWorkspace* ws);
+inline SweepStats magnetization_iteration(MomentSet* set, const DynamicsOptions& opt,
+                                          MagWorkspace* ws) {
+  return magnetization_iteration(*set, set, opt, ws);
+}
 
-/// Sweeps until converged or opt.max_iter; warm-starts from the state in `set`.
-/// `on_iteration(k, set)` (optional) is called after sweep k = 1, 2, …
+/// Sweeps until converged or opt.max_iter; warm-starts from the magnetization *mz of the
+/// moments `set`. `on_iteration(k, *mz)` (optional) is called after sweep k = 1, 2, …
 /// Method::Anderson runs the Anderson-accelerated Picard solve of magnetics/anderson.hpp
 /// instead (one field evaluation per iteration, the same stopping rule and cap).
+RelaxStats relax_magnetization(
+    const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt, MagWorkspace* ws,
+    const std::function<void(int, const Magnetization&)>& on_iteration = {});
+/// The same on a MomentSet, `on_iteration(k, *set)`.
 RelaxStats relax_magnetization(MomentSet* set, const DynamicsOptions& opt, MagWorkspace* ws,
                                const std::function<void(int, const MomentSet&)>& on_iteration = {});
 

@@ -68,8 +68,7 @@ int MomentSet::add_permanent(const Vec3& p, double V, const Vec3& m, std::int32_
   return static_cast<int>(position.size()) - 1;
 }
 
-void MomentSet::set_magnetization(std::size_t j, const Vec3& Mj) {
-  const double ms = Ms[j];
+void Magnetization::set_magnetization(std::size_t j, const Vec3& Mj, double ms) {
   const double n = Mj.norm();
   const double c = std::min(n / ms, 1.0);
   const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
@@ -96,7 +95,7 @@ void MomentSet::reset_magnetization() {
   }
 }
 
-std::size_t MomentSet::induced_count() const {
+std::size_t MomentDesc::induced_count() const {
   return static_cast<std::size_t>(
       std::count(kind.begin(), kind.end(), MomentKind::Induced));
 }

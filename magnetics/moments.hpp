@@ -14,8 +14,9 @@
 
 namespace magsim::mag {
 
-struct MomentSet {
-  // description
+/// Where the moments are and what they are made of: everything the field, force and
+/// dynamics code reads besides the magnetization.
+struct MomentDesc {
   std::vector<Vec3> position;       ///< (n) world position (m)
   std::vector<double> volume;       ///< (n) volume the moment stands for (m³), > 0
   std::vector<double> Ms;           ///< (n) saturation magnetization (A/m); 0 for permanent
@@ -29,29 +30,49 @@ struct MomentSet {
   std::vector<double> radius;
   Vec3 H0 = Vec3::Zero();           ///< uniform external field (A/m)
 
-  // state (induced moments; permanent moments keep M = m/V and M1 = M2 = 0)
+  std::size_t size() const { return position.size(); }
+  std::size_t induced_count() const;
+};
+
+/// The magnetization of the moments of a MomentDesc, the state the dynamics evolve (induced
+/// moments; permanent moments keep M = m/V and M1 = M2 = 0). Held apart from the description
+/// so that its owner — the engine keeps it in its State — is the only copy the solvers work on.
+struct Magnetization {
   std::vector<Vec3> M1, M2;  ///< (n) sub-magnetizations, |M_jk| = Ms_j (A/m)
   std::vector<Vec3> M;       ///< (n) magnetization (A/m)
   std::vector<std::uint8_t> seeded;  ///< (n) 0 until the sub-pair axis has been chosen
 
-  std::size_t size() const { return position.size(); }
+  /// Sets induced moment j's magnetization to Mj (|Mj| ≤ Ms) keeping the sub-pair axis
+  /// where possible: M_j1,2 = Ms (cos φ u ± sin φ w), cos φ = |Mj|/Ms.
+  void set_magnetization(std::size_t j, const Vec3& Mj, double Ms);
+};
 
+/// The dipole moment m_j: V_j M_j for induced, m_perm_j for permanent (A·m²).
+inline Vec3 moment(const MomentDesc& d, const Magnetization& mz, std::size_t j) {
+  return d.kind[j] == MomentKind::Induced ? Vec3(d.volume[j] * mz.M[j]) : d.m_perm[j];
+}
+
+/// A magnetic system in one piece, description and magnetization (tools, tests, scratch).
+/// The solvers take (MomentDesc, Magnetization); their MomentSet forms pass the set as both.
+struct MomentSet : MomentDesc, Magnetization {
   /// Adds an unmagnetized induced moment (M = 0; its sub-pair axis is seeded on the first
   /// dynamics iteration, perpendicular to the field it feels). Returns its index.
   int add_induced(const Vec3& p, double V, double Ms_, std::int32_t grp = -1);
   /// Adds a permanent moment m (A·m²) of volume V. Returns its index.
   int add_permanent(const Vec3& p, double V, const Vec3& m, std::int32_t grp = -1);
 
-  /// The dipole moment m_j: V_j M_j for induced, m_perm_j for permanent (A·m²).
-  Vec3 moment(std::size_t j) const {
-    return kind[j] == MomentKind::Induced ? Vec3(volume[j] * M[j]) : m_perm[j];
-  }
-  /// Sets an induced moment's magnetization to M (|M| ≤ Ms) keeping the sub-pair axis
-  /// where possible: M_j1,2 = Ms (cos φ u ± sin φ w), cos φ = |M|/Ms.
-  void set_magnetization(std::size_t j, const Vec3& Mj);
+  /// The dipole moment m_j (mag::moment).
+  Vec3 moment(std::size_t j) const { return mag::moment(*this, *this, j); }
+  /// Magnetization::set_magnetization with the moment's own Ms.
+  using Magnetization::set_magnetization;
+  void set_magnetization(std::size_t j, const Vec3& Mj) { set_magnetization(j, Mj, Ms[j]); }
   /// Forgets every induced magnetization (M = 0, unseeded).
   void reset_magnetization();
-  std::size_t induced_count() const;
+  /// Copies a description and its magnetization in (a scratch set keeps its storage).
+  void assign(const MomentDesc& d, const Magnetization& mz) {
+    MomentDesc::operator=(d);
+    Magnetization::operator=(mz);
+  }
 };
 
 /// A unit vector perpendicular to u (|u| > 0), chosen deterministically.

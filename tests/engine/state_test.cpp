@@ -25,7 +25,7 @@ TEST_CASE("state: the hash sees every bit of poses, velocities and magnetization
     u ^= 1u;
     std::memcpy(x, &u, 8);
   };
-  flip(&b.M1[3].y());
+  flip(&b.mag.M1[3].y());
   CHECK(engine::state_hash(a) != engine::state_hash(b));
   b = a;
   flip(&b.angvel[2].z());

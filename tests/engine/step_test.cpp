@@ -124,7 +124,7 @@ TEST_CASE("step: every method runs and pulls a ball toward the magnet", "[step]"
     // one and the Newton solve are required to converge here
     if (method == mag::Method::OursRealigned || method == mag::Method::Exact)
       CHECK(sim.last_profile().converged);
-    CHECK(sim.moments().M[1].z() > 0);  // magnetized along the magnet's field
+    CHECK(sim.state().mag.M[1].z() > 0);  // magnetized along the magnet's field
   }
 }
 

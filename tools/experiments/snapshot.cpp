@@ -100,9 +100,9 @@ Snapshot sakura_snapshot(const SnapshotOpts& o, const std::string& out) {
     sim.step();
     max_speed = std::max(max_speed, sim.metrics().max_speed);
   }
-  const mag::MomentSet prev = sim.moments();
+  const mag::Magnetization prev = sim.state().mag;
   sim.step();
-  const mag::MomentSet& now = sim.moments();
+  const mag::MomentDesc& now = sim.moments();
   if (now.size() != sn.warm.size()) throw std::runtime_error("snapshot: moment count differs");
   sn.warm.position = now.position;
   sn.warm.m_perm = now.m_perm;

@@ -110,12 +110,13 @@ class Recorder {
       std::fprintf(states_, "%d,%.9g,%d,%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", f, t, b,
                    csv_field(m.body_name[b]).c_str(), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z());
     }
-    const mag::MomentSet& ms = sim_.moments();
+    const mag::MomentDesc& ms = sim_.moments();
+    const mag::Magnetization& mz = s.mag;
     for (int j = 0; j < m.nmoment; ++j) {
       const engine::Vec3& p = ms.position[j];
       std::fprintf(moments_, "%d,%.9g,%d,%d,%.10g,%.10g,%.10g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                   f, t, j, m.moment_body[j], p.x(), p.y(), p.z(), s.M[j].x(), s.M[j].y(), s.M[j].z(),
-                   s.M1[j].x(), s.M1[j].y(), s.M1[j].z(), s.M2[j].x(), s.M2[j].y(), s.M2[j].z());
+                   f, t, j, m.moment_body[j], p.x(), p.y(), p.z(), mz.M[j].x(), mz.M[j].y(), mz.M[j].z(),
+                   mz.M1[j].x(), mz.M1[j].y(), mz.M1[j].z(), mz.M2[j].x(), mz.M2[j].y(), mz.M2[j].z());
     }
     const engine::Metrics x = sim_.metrics();
     series_["time"].push_back(t);
