@@ -13,8 +13,10 @@
 #include <vector>
 
 // AVX-512 kernels are compiled per function (target attribute) and chosen at run time, so
-// the rest of the build stays at AVX2 (see CMakeLists.txt)
-#if defined(__x86_64__) && defined(__GNUC__)
+// the rest of the build stays at AVX2 (see CMakeLists.txt). The portable build
+// (-DMAGSIM_NATIVE=OFF defines MAGSIM_PORTABLE_KERNELS) has none: its field sums must not
+// depend on the CPU it runs on.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(MAGSIM_PORTABLE_KERNELS)
 #include <immintrin.h>
 #define MAGSIM_AVX512_KERNEL 1
 #define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
@@ -118,10 +120,21 @@ void sum_pairs_f32(const SourceViewF& v, const TargetF& t, float eps2, PairTerms
 inline constexpr std::size_t kChunkF = 1024;
 
 /// True when sum_pairs (and the Barnes–Hut far-cell kernels, double and float) run the
-/// AVX-512 path: the CPU has it and it has not been switched off.
+/// AVX-512 path: the build has it (not -DMAGSIM_NATIVE=OFF), the CPU has it, the
+/// environment does not force the portable loops and it has not been switched off.
+///
+/// MAGSIM_KERNEL=portable in the environment (read once, at the first field evaluation)
+/// forces the portable loops in any build, so that one CPU can run the path another CPU
+/// would; unset or any other value: AVX-512 where the CPU has it. (The command-line
+/// programs accept only unset, "auto" or "portable", tools/cli_common.hpp.) In a native
+/// build the rest of the code still uses the build CPU's instructions (FMA), so this
+/// reproduces a native build on a CPU without AVX-512, not the portable build.
 bool simd_kernel_active();
 /// Switches the AVX-512 path off (false) or back on, for tests and benchmarks that compare
-/// it with the portable loop. Not to be called while a field evaluation runs.
+/// it with the portable loop; "on" cannot override MAGSIM_KERNEL=portable. Not to be called
+/// while a field evaluation runs.
 void enable_simd_kernel(bool on);
+/// True when MAGSIM_KERNEL=portable was set in the environment (read once).
+bool portable_kernel_forced();
 
 }  // namespace magsim::mag::detail

@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 
 namespace magsim::mag::detail {
 
@@ -250,9 +252,18 @@ void dispatch(const View& v, const typename Precision<View>::Tgt& t,
 
 void enable_simd_kernel(bool on) { g_simd_enabled = on; }
 
+bool portable_kernel_forced() {
+  static const bool forced = [] {
+    const char* v = std::getenv("MAGSIM_KERNEL");
+    return v != nullptr && std::strcmp(v, "portable") == 0;
+  }();
+  return forced;
+}
+
 bool simd_kernel_active() {
 #ifdef MAGSIM_AVX512_KERNEL
-  return cpu_has_avx512() && g_simd_enabled.load(std::memory_order_relaxed);
+  return cpu_has_avx512() && !portable_kernel_forced() &&
+         g_simd_enabled.load(std::memory_order_relaxed);
 #else
   return false;
 #endif

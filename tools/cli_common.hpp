@@ -112,6 +112,16 @@ inline std::string omp_num_threads_error() {
   return {};
 }
 
+/// "" when MAGSIM_KERNEL is unset, "auto" or "portable" (magnetics/field_kernel.hpp: the
+/// portable field kernels even on a CPU with AVX-512), else the one-line reason. The library
+/// takes any other value as "auto"; both programs refuse it, so that a typo cannot pass for
+/// the switch.
+inline std::string magsim_kernel_error() {
+  const char* v = std::getenv("MAGSIM_KERNEL");
+  if (!v || std::strcmp(v, "auto") == 0 || std::strcmp(v, "portable") == 0) return {};
+  return "MAGSIM_KERNEL='" + one_line(v) + "': must be auto or portable, or unset";
+}
+
 // ---- flag validators ---------------------------------------------------------------------
 // CLI11's own ranges print their bounds with std::to_string (DBL_MAX as 309 digits) and its
 // integer conversion takes 0x10 as 16 and 010 as 8; these print %g and take decimal only.

@@ -11,6 +11,9 @@
 #include <cinttypes>
 #include <cstdio>
 #include <string>
+#if defined(__x86_64__) && defined(__GLIBC__)
+#include <sys/platform/x86.h>  // CPU_FEATURE_ACTIVE: the CPU features glibc uses
+#endif
 
 using namespace magsim;
 
@@ -38,35 +41,114 @@ std::string run_hash(const char* name, long steps, engine::SpaceKind space, int 
 }  // namespace
 
 #if MAGSIM_GOLDEN_HASHES
-// Stored hashes of the five registry scenes after 100 rigid steps (the Release build with
-// MAGSIM_NATIVE on this project's CI machine, AMD EPYC with AVX-512: the field kernel and
-// Eigen take the CPU's SIMD paths, so another CPU or the sanitizer/Debug builds round
-// differently and CMake leaves this test out there; tests/engine/CMakeLists.txt).
+// Stored hashes of the five registry scenes after 100 rigid steps, one table per path whose
+// rounding is fixed by the build and by the variants of tanh, log1p, exp, sin, … that glibc's
+// libm (Debian 12, glibc 2.36) picks at run time: its FMA ones where FMA and AVX2 are
+// active, else its SSE2/AVX ones, which round alike; they differ from the FMA ones in the
+// last bit now and then, and one such bit changes a hash.
+// - kAvx512: a Release build with MAGSIM_NATIVE on a CPU with AVX-512 (AVX-512 field
+//   kernels, the rest at -march=native's AVX2+FMA; made on this project's CI machine, AMD
+//   EPYC, and the same on an Intel Xeon).
+// - kNativeAvx2Fma: the same build with the portable field kernels, on a CPU with AVX2 and
+//   FMA but without AVX-512 or with MAGSIM_KERNEL=portable (the same with -march=haswell).
+// - kPortable, kPortablePlainLibm: any build with -DMAGSIM_NATIVE=OFF (baseline x86-64, no
+//   FMA, the portable kernels only; CMakeLists.txt), Release and ASan+UBSan alike, on every
+//   x86-64 CPU; the second where libm takes its SSE2/AVX variants (a CPU without FMA or
+//   AVX2, or GLIBC_TUNABLES=glibc.cpu.hwcaps=-FMA,-AVX2).
+// Where no table applies (a native build without FMA, libm's FMA4 variants of old AMD CPUs,
+// not x86-64 glibc) the test says so and checks nothing: FAIL would blame the change.
 // A change that alters results fails here. When the change is meant to alter them (a new
-// default, a fixed bug), say so in the commit, run this test, and copy the "now" hashes it
-// prints into the table; a refactor must leave them as they are.
-TEST_CASE("golden state hashes: the five registry scenes after 100 steps", "[golden]") {
-  struct Golden {
-    const char* scene;
-    const char* hash;
-  };
-  const Golden golden[] = {
-      {"balls_up", "a95d03b1a1d85ead"},
-      {"alphabets", "a08347b1f131819d"},
-      {"falling_magnet", "238b3fe44529569e"},
-      {"sakura_tree", "52b314053185f5da"},
-      {"crystal_balls", "3938248ff8cd8a71"},
-  };
-  if (!mag::detail::simd_kernel_active()) {
-    // the stored values come from the AVX-512 field kernels; the portable ones round otherwise
-    WARN("no AVX-512 on this CPU: the golden hashes (made with the AVX-512 kernels) are not checked");
-    return;
-  }
-  for (const Golden& g : golden) {
+// default, a fixed bug), say so in the commit, run this test in the native and the portable
+// build (tools/test.sh, tools/test.sh --portable) with MAGSIM_KERNEL unset and =portable, and
+// with GLIBC_TUNABLES as above, and copy the "now" hashes it prints into the tables; a
+// refactor must leave them as they are.
+namespace {
+
+struct Golden {
+  const char* scene;
+  const char* hash;
+};
+
+const Golden kAvx512[] = {
+    {"balls_up", "a95d03b1a1d85ead"},
+    {"alphabets", "a08347b1f131819d"},
+    {"falling_magnet", "238b3fe44529569e"},
+    {"sakura_tree", "52b314053185f5da"},
+    {"crystal_balls", "3938248ff8cd8a71"},
+};
+
+const Golden kNativeAvx2Fma[] = {
+    {"balls_up", "6884994471367f75"},
+    {"alphabets", "03468c425ae3feea"},
+    {"falling_magnet", "124611e6b08a5914"},
+    {"sakura_tree", "29f01ee83a42e7b1"},
+    {"crystal_balls", "94c3c759b96a9f85"},
+};
+
+const Golden kPortable[] = {
+    {"balls_up", "94239bb97e8d3e69"},
+    {"alphabets", "9371753068e0da4c"},
+    {"falling_magnet", "5afbcb81988335a6"},
+    {"sakura_tree", "d91180a773bc03d6"},
+    {"crystal_balls", "944c301ec9d67fad"},
+};
+
+const Golden kPortablePlainLibm[] = {
+    {"balls_up", "049979a4ba1772b6"},
+    {"alphabets", "db1a4c3f6f63e2c1"},
+    {"falling_magnet", "c8d7b0d917cf4639"},
+    {"sakura_tree", "d91180a773bc03d6"},
+    {"crystal_balls", "944c301ec9d67fad"},
+};
+
+void check_hashes(const Golden (&table)[5], const char* path) {
+  for (const Golden& g : table) {
     const std::string now = run_hash(g.scene, 100, engine::SpaceKind::SweepAndPrune);
-    INFO(g.scene << ": now " << now << ", stored " << g.hash);
+    INFO(path << ", " << g.scene << ": now " << now << ", stored " << g.hash);
     CHECK(now == g.hash);
   }
+}
+
+/// Which variants glibc's libm runs here (its ifunc rule for tanh, log1p, exp, sin, …).
+enum class Libm { Fma, Fma4, Plain, Unknown };
+Libm libm_variants() {
+#if defined(__x86_64__) && defined(__GLIBC__)
+  if (CPU_FEATURE_ACTIVE(FMA) && CPU_FEATURE_ACTIVE(AVX2)) return Libm::Fma;
+  if (CPU_FEATURE_ACTIVE(FMA4)) return Libm::Fma4;
+  return Libm::Plain;
+#else
+  return Libm::Unknown;
+#endif
+}
+
+}  // namespace
+
+TEST_CASE("golden state hashes: the five registry scenes after 100 steps", "[golden]") {
+  const Libm libm = libm_variants();
+#ifdef MAGSIM_PORTABLE_KERNELS
+  REQUIRE_FALSE(mag::detail::simd_kernel_active());  // the portable build has no AVX-512 path
+  if (libm == Libm::Fma) {
+    check_hashes(kPortable, "portable build, libm's FMA variants");
+  } else if (libm == Libm::Plain) {
+    check_hashes(kPortablePlainLibm, "portable build, libm's SSE2/AVX variants");
+  } else {
+    WARN("no golden hashes for this libm: FMA4 variants (AMD family 15h) or not x86-64 glibc");
+  }
+#else
+  if (libm != Libm::Fma) {
+    WARN("native build without libm's FMA variants: no golden hashes here; a build with "
+         "-DMAGSIM_NATIVE=OFF (tools/test.sh --portable) checks them on any x86-64 CPU");
+  } else if (mag::detail::simd_kernel_active()) {
+    check_hashes(kAvx512, "native build, AVX-512 kernels");
+  } else {
+#if defined(__AVX2__) && defined(__FMA__)
+    check_hashes(kNativeAvx2Fma, "native build (AVX2+FMA), portable kernels");
+#else
+    WARN("native build without AVX2 and FMA: no golden hashes for its rounding; a build with "
+         "-DMAGSIM_NATIVE=OFF (tools/test.sh --portable) checks them on any x86-64 CPU");
+#endif
+  }
+#endif
 }
 #endif
 

@@ -248,7 +248,9 @@ TEST_CASE("Barnes–Hut float far cells: AVX-512 and portable kernels agree to f
                    << e.h_max << "; J rms " << e.j_rms << " max " << e.j_max);
     CHECK(e.h_rms <= 2e-6);
     CHECK(e.j_rms <= 2e-6);
-    CHECK(e.h_rms > 0);  // (the float far path did run: the two kernels round differently)
+    // the float far path did run: the two kernels round differently (without AVX-512 both
+    // runs take the portable loop)
+    if (detail::simd_kernel_active()) CHECK(e.h_rms > 0);
     // and with the default leaves and groups
     FieldOptions d = bh_options(0.3);
     d.softening = o.softening;

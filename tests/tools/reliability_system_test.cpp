@@ -98,6 +98,25 @@ TEST_CASE("OMP_NUM_THREADS: above 4x the cores or not a thread count is refused 
   CHECK(magsim::test::run_command("OMP_NUM_THREADS=1 " + std::string(MAGSOLVE_BIN), example("touching_spheres.json")).code == 0);
 }
 
+TEST_CASE("MAGSIM_KERNEL: only auto or portable is taken, anything else is refused in one line, exit 1", "[reliability]") {
+  for (const char* value : {"Portable", "avx512", ""}) {
+    for (const bool solver : {true, false}) {
+      const std::string env = std::string("MAGSIM_KERNEL='") + value + "' ";
+      const CommandResult r = solver ? magsim::test::run_command(env + MAGSOLVE_BIN, example("touching_spheres.json"))
+                                     : magsim::test::run_command(env + MAGSIM_SCENE_BIN,
+                                                                 "balls_up --count 5 --steps 1 --no-render --out " +
+                                                                     tmp("kernel"));
+      INFO((solver ? "magsolve" : "magsim-scene") << " MAGSIM_KERNEL='" << value << "': exit " << r.code << ": " << r.out);
+      CHECK(r.code == 1);
+      CHECK(r.out.find("MAGSIM_KERNEL='" + std::string(value) + "': must be auto or portable") != std::string::npos);
+      CHECK(lines(r.out) == 1);
+    }
+  }
+  for (const char* value : {"auto", "portable"})
+    CHECK(magsim::test::run_command(std::string("MAGSIM_KERNEL=") + value + " " + MAGSOLVE_BIN,
+                                    example("touching_spheres.json")).code == 0);
+}
+
 TEST_CASE("a closed pipe: magsolve's results are an I/O error (exit 3), a scene run is not killed", "[reliability]") {
   const std::string err = tmp("pipe_err.txt");
   const Ended m = run_into_closed_pipe(std::string("exec ") + MAGSOLVE_BIN + " " + example("touching_spheres.json") + " 2>" + err);

@@ -343,12 +343,18 @@ int main(int argc, char** argv) {
                                       "Runs longer than 1e7 rigid steps are refused; so are runs whose estimated memory exceeds "
                                       "MemAvailable or what ulimit -v leaves, scene files that are not regular "
                                       "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n"
+                                      "MAGSIM_KERNEL=portable: the portable field kernels even on a CPU with AVX-512 "
+                                      "(unset or auto: AVX-512 where the CPU has it; other values are refused).\n"
                                       "Every option flag has the range of its scene-file key (scenes/option_ranges.hpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
                                       "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
                                       "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
   if (const int code = tools::parse_command_line(app, argc, argv, "error: "); code >= 0) return code;
   if (const std::string e = tools::omp_num_threads_error(); !e.empty()) {
+    std::fprintf(stderr, "error: %s\n", e.c_str());
+    return kBadInput;
+  }
+  if (const std::string e = tools::magsim_kernel_error(); !e.empty()) {
     std::fprintf(stderr, "error: %s\n", e.c_str());
     return kBadInput;
   }
