@@ -130,16 +130,16 @@ SceneDesc balls_up(const SceneParams& p) {
 
 // ---------------------------------------------------------------------------------------
 // alphabets — 100 letter pieces (iron, 3 cm tall, 5 mm strokes, 1 induced moment per
-// stroke box) on a 5×5×4 grid at 7 cm pitch, no gravity; an invisible, "excessively strong"
-// 600 A·m² moment at the grid centre with an invisible collider of radius 2 cm (the paper's
-// fiction: no real magnet of that size carries it; an N52 sphere of 600 A·m² would have a
-// radius of 5.1 cm at 1.1e6 A/m). Where a stroke lies on the collider its moment is 2.25 cm from the
-// centre: |H| = 2m/(4π r³) = 8.4 MA/m = 5.2 Ms on the axis, inside Fig. 9's region
-// |H| ≥ 2.5 Ms where Kim 2018's dynamics fails. 600 rather than 300 A·m²: the grid's corner
-// letters start 0.22 m out, where the pull falls as r⁻⁷, and at 300 A·m² they were still
-// arriving 1.5 s in (tools/findings/energy.md). Letters arrive at up to 15 m/s, so the frame
-// splits into up to 16 rigid sub-steps where bodies in contact move fast or are pressed hard
-// into their contacts (tools/findings/alphabets.md).
+// stroke box) on a 5×5×4 grid at 6 cm pitch, no gravity; an invisible, "excessively strong"
+// 300 A·m² moment at the grid centre with an invisible collider of radius 2 cm (the paper's
+// fiction: no real magnet of that size carries it; an N52 sphere of 300 A·m² would have a
+// radius of 4.0 cm at 1.1e6 A/m). Where a stroke lies on the collider its moment is 2.25 cm
+// from the centre: |H| = 2m/(4π r³) = 4.2 MA/m = 2.6 Ms on the axis, inside Fig. 9's region
+// |H| ≥ 2.5 Ms where Kim 2018's dynamics fails. 6 cm rather than 7 cm: the corner letters
+// start where the pull falls as r⁻⁷, so their time to arrive goes as the distance^4.5; from
+// 0.22 m they were still arriving 1.5 s in (tools/findings/energy.md). Letters arrive at up to
+// 15 m/s, so the frame splits into up to 16 rigid sub-steps where bodies in contact move fast
+// or are pressed hard into their contacts (tools/findings/alphabets.md).
 struct Stroke {
   double x0, y0, x1, y1;  // glyph units: width 2, height 3
 };
@@ -191,7 +191,7 @@ SceneDesc alphabets(const SceneParams& p) {
       "letters = 1–4 boxes, 1 induced moment per box; central moment: static, invisible, "
       "with an invisible sphere collider of radius 2 cm; no gravity, no ground";
   const int N = p.count > 0 ? p.count : 100;
-  const double pitch = 0.07;  // (m) grid pitch: letters 3 cm tall start 4 cm apart
+  const double pitch = 0.06;  // (m) grid pitch: letters 3 cm tall start 3 cm apart
   // beyond 100 letters (--count) the grid repeats, each repeat 2 cm higher
   const double repeat_shift = 0.02;  // (m)
   std::mt19937 rng(2018);
@@ -204,7 +204,7 @@ SceneDesc alphabets(const SceneParams& p) {
   }
   const double Rc = 0.02;  // (m) radius of the invisible collider around the central moment
   BodyDesc c = magnet_body("centre", BodyType::Static, Vec3::Zero(), ShapeKind::Sphere, Vec3(Rc, Rc, Rc),
-                           {permanent_moment(sphere_volume(Rc), Vec3(0, 0, 600.0 * p.strength))});
+                           {permanent_moment(sphere_volume(Rc), Vec3(0, 0, 300.0 * p.strength))});
   c.visible = false;
   c.color = BodyDesc{}.color;  // never drawn
   s.bodies.push_back(c);
@@ -215,10 +215,10 @@ SceneDesc alphabets(const SceneParams& p) {
   s.options.magnetics.field.softening = 0.005;  // (m)
   s.options.quickstep_iterations = 50;
   s.options.max_substeps = 16;  // see above: letters arrive at up to 15 m/s
-  s.camera.eye = Eigen::Vector3f(0.45f, -0.55f, 0.30f);
+  s.camera.eye = Eigen::Vector3f(0.386f, -0.471f, 0.257f);  // the grid at 7 cm pitch framed as before, × 6/7
   s.camera.target = Eigen::Vector3f(0, 0, 0);
   s.default_seconds = 3.0;
-  // the grid's corners start 0.22 m from the centre (3-D, no gravity): beyond 0.3 m a
+  // the grid's corners start 0.19 m from the centre (3-D, no gravity): beyond 0.3 m a
   // letter is flying away, not gathering
   s.escape_radius = 0.3;  // (m)
   return s;
