@@ -31,9 +31,4 @@ void from_json(const JsonReader& r, const nlohmann::json& j, const std::string& 
 /// [x, y, z]: how scene files, summary.json and the options write a vector.
 inline nlohmann::json vec3_json(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 
-/// Every method name, in the order of mag::Method, from mag::method_name (the one table).
-const std::vector<std::string>& method_names();
-/// "a, b, c" of method_names(), for messages and help.
-std::string method_list(const char* sep = ", ");
-
 }  // namespace magsim::scenes

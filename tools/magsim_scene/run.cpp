@@ -289,7 +289,7 @@ int run(const Args& a, const CLI::App& app) {
       {"modelling_level", scene.modelling_level},
       {"method", method},
       // the force actually used, in --force-model's spelling ("zeeman" = eq. 4)
-      {"force_model", engine::force_model_name(engine::resolved_force_model(model.options))},
+      {"force_model", mag::kForceModelNames.name(engine::resolved_force_model(model.options))},
       // the run's options in the scene file's spelling (scenes/options_json.hpp): pasted into
       // a scene file as "options" they rerun this run
       {"options", scenes::to_json(model.options)},
