@@ -13,7 +13,7 @@
 namespace magsim::engine {
 
 void compute_magnetic_forces(const Model& m, const mag::MomentSet& set, Workspace* ws) {
-  mag::compute_forces(set, resolved_force_model(m.options), mag::curve_of(m.options.method),
+  mag::compute_forces(set, resolved_force_model(m.options), mag::curve_of(m.options.magnetics.method),
                       m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
                       m.options.reaction_symmetric_forces);
 }

@@ -11,7 +11,7 @@ namespace magsim::engine {
 void magnetize(const Model& m, mag::MomentSet* set, Workspace* ws, StepProfile* prof) {
   if (m.induced_count == 0) return;  // nothing to magnetize: permanent moments only
   const mag::DynamicsOptions& opt = m.options.magnetics;
-  if (m.options.method == mag::Method::Exact) {
+  if (m.options.magnetics.method == mag::Method::Exact) {
     const mag::ExactStats st = mag::solve_exact(set, mag::curve_of(mag::Method::Exact), opt.field);
     prof->iterations += st.newton_steps;
     prof->converged = prof->converged && st.converged;

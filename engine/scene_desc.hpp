@@ -81,17 +81,17 @@ inline bool parse_space(const std::string& name, SpaceKind* out) { return kSpace
 
 /// Run options. Defaults are the engine's; each scene overrides what it needs.
 struct SimOptions {
-  /// The magnetization solve. The default, Anderson-accelerated M = f(H(M)) with the classic
-  /// force, converges every rigid (sub-)step and makes the force −∇U* (magnetics/coenergy.hpp):
-  /// passive scenes lose energy and come to rest. `ours` is the paper as printed (θ dynamics
-  /// eqs. 8–11, eq. 4), whose force has no energy.
-  mag::Method method = mag::Method::Anderson;
-  /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps when the
-  /// residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::criterion, default Residual)
-  /// or after 100 sweeps per rigid step: warm-started from the last step, a converging method
-  /// needs a handful; a cap hit is counted in the profile.
+  /// The magnetization solve: its method, Δt_m, β, tolerance, cap … The method (the scene
+  /// file's top-level "method") defaults to anderson: Anderson-accelerated M = f(H(M)) with
+  /// the classic force converges every rigid (sub-)step and makes the force −∇U*
+  /// (magnetics/coenergy.hpp), so passive scenes lose energy and come to rest. `ours` is the
+  /// paper as printed (θ dynamics eqs. 8–11, eq. 4), whose force has no energy. Scenes stop
+  /// the sweeps when the residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::
+  /// criterion, default Residual) or after 100 sweeps per rigid step: warm-started from the
+  /// last step, a converging method needs a handful; a cap hit is counted in the profile.
   mag::DynamicsOptions magnetics = [] {
     mag::DynamicsOptions d;
+    d.method = mag::Method::Anderson;
     d.tol = 1e-4;
     d.max_iter = 100;
     return d;
@@ -195,7 +195,7 @@ struct SimOptions {
 /// The force on induced moments that `o` resolves to (mag::resolve_force_model): never
 /// ForceModel::Method.
 inline mag::ForceModel resolved_force_model(const SimOptions& o) {
-  return mag::resolve_force_model(o.force_model, o.method);
+  return mag::resolve_force_model(o.force_model, o.magnetics.method);
 }
 /// The resolved force is the gradient of an energy (classic: −∇U*; zeeman-total: −∇E_sys), so
 /// the energy guard can check it. eq. 4 (zeeman) is not.

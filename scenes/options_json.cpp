@@ -33,7 +33,7 @@ json to_json(const mag::DynamicsOptions& d) {
 
 json to_json(const SimOptions& o) {
   const mag::FieldOptions& f = o.magnetics.field;
-  return json{{"method", mag::method_name(o.method)},
+  return json{{"method", mag::method_name(o.magnetics.method)},
               {"dt", o.dt},
               {"gravity", vec3_json(o.gravity)},
               {"ground", o.ground},
@@ -115,7 +115,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
                    "bh_near_float", "bh_far_float", "energy_guard", "energy_guard_tolerance",
                    "energy_guard_floor", "energy_guard_max_substeps"});
-  if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = r.named(v, p, mag::kMethodNames, "method"); });
+  if_present(j, "method", path, [&](const json& v, const std::string& p) { o->magnetics.method = r.named(v, p, mag::kMethodNames, "method"); });
   if_present(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.option(v, p, option_range("dt"));
   });
@@ -170,7 +170,6 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "bh_far_float", path, [&](const json& v, const std::string& p) { f.bh_far_float = r.boolean(v, p); });
   if_present(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
   if_present(j, "magnetics", path, [&](const json& v, const std::string& p) { from_json(r, v, p, &o->magnetics); });
-  o->magnetics.method = o->method;
 }
 
 }  // namespace magsim::scenes

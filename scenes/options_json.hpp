@@ -17,8 +17,8 @@ namespace magsim::scenes {
 
 /// Every SimOptions field under its scene-file name ("dt", "space", "magnetics": {…}, …).
 nlohmann::json to_json(const engine::SimOptions& o);
-/// The "magnetics" object: every DynamicsOptions field but the method (SimOptions::method
-/// holds it), with FieldOptions' softening and bounded_pairs (the other field options sit
+/// The "magnetics" object: every DynamicsOptions field but the method (the options' top-level
+/// "method" holds it), with FieldOptions' softening and bounded_pairs (the other field options sit
 /// beside it in "options": field_solver, bh_theta, bh_threshold, bh_*).
 nlohmann::json to_json(const mag::DynamicsOptions& d);
 

@@ -72,7 +72,7 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   magsim::scenes::SceneParams p;
   p.count = count;
   eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
-  d.options.method = method;
+  d.options.magnetics.method = method;
   if (threads > 0) d.options.threads = threads;
   field.apply(&d.options.magnetics.field);
   if (solver) d.options.magnetics.field.solver = *solver;

@@ -156,7 +156,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     }
     s = e->build(p);
   }
-  if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
+  if (app.count("--method") && !mag::parse_method(a.method, &s.options.magnetics.method))
     throw UsageError("--method: " + mag::kMethodNames.unknown("method", a.method));
   // the thread cap holds for the flag and the scene file alike (--write-scene too)
   const std::string cap = "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
@@ -202,7 +202,6 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     throw UsageError(e.what());
   }
   if (const std::string e = mag::validate(f); !e.empty()) throw UsageError("field options: " + e);
-  s.options.magnetics.method = s.options.method;
   return s;
 }
 
