@@ -12,7 +12,7 @@ void magnetize(const Model& m, const mag::MomentDesc& set, mag::Magnetization* m
                Workspace* ws, StepProfile* prof) {
   if (m.induced_count == 0) return;  // nothing to magnetize: permanent moments only
   const mag::DynamicsOptions& opt = m.options.magnetics;
-  if (m.options.method == mag::Method::Exact) {
+  if (m.options.magnetics.method == mag::Method::Exact) {
     const mag::ExactStats st =
         mag::solve_exact(set, mz, mag::curve_of(mag::Method::Exact), opt.field);
     prof->iterations += st.newton_steps;

@@ -100,9 +100,7 @@ void check_options(const SimOptions& o, const Vec3& H0) {
          "needs reaction_symmetric_forces (it removes the torque those forces leave)");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
-  mag::DynamicsOptions d = o.magnetics;
-  d.method = o.method;
-  const std::string e = mag::validate(d);
+  const std::string e = mag::validate(o.magnetics);
   if (!e.empty()) fail("options.magnetics", e);
 }
 
@@ -270,7 +268,6 @@ Model compile_model(const SceneDesc& scene) {
 
   Model m;
   m.options = scene.options;
-  m.options.magnetics.method = scene.options.method;
   m.H0 = scene.H0;
   if (const std::string e = camera_error(scene.camera); !e.empty()) fail("camera", e);
   m.camera = scene.camera;

@@ -30,7 +30,7 @@ struct Model {
   int nshape = 0;
   int nmoment = 0;
 
-  // options (validated; options.magnetics.method == options.method)
+  // options (validated)
   SimOptions options;
   Vec3 H0 = Vec3::Zero();  ///< uniform external field (A/m)
   render::Camera camera;

@@ -16,6 +16,11 @@ using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
 
 enum class ShapeKind { Sphere, Box, Capsule, Cylinder };
+/// The shape kinds of scene files.
+inline constexpr mag::NameTable<ShapeKind, 4> kShapeKindNames{{{ShapeKind::Sphere, "sphere"},
+                                                               {ShapeKind::Box, "box"},
+                                                               {ShapeKind::Capsule, "capsule"},
+                                                               {ShapeKind::Cylinder, "cylinder"}}};
 
 /// A collision + render primitive fixed to a body. Capsules/cylinders lie along local z.
 struct ShapeDesc {
@@ -45,6 +50,9 @@ enum class BodyType {
   Kinematic,  ///< moved by its scripted velocity, not by forces (infinite mass in contacts)
   Static      ///< never moves: a geom without a body
 };
+/// The body types of scene files.
+inline constexpr mag::NameTable<BodyType, 3> kBodyTypeNames{
+    {{BodyType::Dynamic, "dynamic"}, {BodyType::Kinematic, "kinematic"}, {BodyType::Static, "static"}}};
 
 struct BodyDesc {
   std::string name;
@@ -64,71 +72,26 @@ struct BodyDesc {
 
 enum class SpaceKind { Hash, SweepAndPrune, Simple };
 
-/// "hash", "sap", "simple" (scene files, --space, summary.json).
-inline const char* space_name(SpaceKind k) {
-  switch (k) {
-    case SpaceKind::Hash: return "hash";
-    case SpaceKind::SweepAndPrune: return "sap";
-    case SpaceKind::Simple: return "simple";
-  }
-  return "?";
-}
+/// The broad-phase names of scene files, --space and summary.json.
+inline constexpr mag::NameTable<SpaceKind, 3> kSpaceNames{
+    {{SpaceKind::Hash, "hash"}, {SpaceKind::SweepAndPrune, "sap"}, {SpaceKind::Simple, "simple"}}};
+inline const char* space_name(SpaceKind k) { return kSpaceNames.name(k); }
 /// Parses a broad-phase name; returns false (and leaves *out alone) on an unknown name.
-inline bool parse_space(const std::string& name, SpaceKind* out) {
-  for (SpaceKind k : {SpaceKind::Hash, SpaceKind::SweepAndPrune, SpaceKind::Simple})
-    if (name == space_name(k)) {
-      *out = k;
-      return true;
-    }
-  return false;
-}
-
-/// The force on induced moments, chosen apart from the magnetization method.
-enum class ForceChoice {
-  Method,   ///< the method's own pairing (mag::force_model_of): classic for anderson, exact and
-            ///< kim2018, Zeeman (eq. 4) for ours, ours-realigned and damping-llg
-  Zeeman,   ///< eq. 4: F = μ0 V J [A (2M + H) + M]; 2(χ+1) ≈ 8× classic in the linear range
-  Classic,  ///< eqs. 13–14: F = μ0 J m, m held constant
-  /// eq. 4 as the gradient of the system's Zeeman energy, every magnetization a variable
-  /// (mag::compute_forces): conservative and momentum-conserving; reaction_symmetric_forces
-  /// has no effect on it
-  ZeemanTotal
-};
-
-/// "method", "zeeman", "classic", "zeeman-total" (scene files, --force-model, summary.json).
-inline const char* force_choice_name(ForceChoice f) {
-  switch (f) {
-    case ForceChoice::Method: return "method";
-    case ForceChoice::Zeeman: return "zeeman";
-    case ForceChoice::Classic: return "classic";
-    case ForceChoice::ZeemanTotal: return "zeeman-total";
-  }
-  return "?";
-}
-/// Parses a force model name; returns false (and leaves *out alone) on an unknown name.
-inline bool parse_force_choice(const std::string& name, ForceChoice* out) {
-  for (ForceChoice f : {ForceChoice::Method, ForceChoice::Zeeman, ForceChoice::Classic,
-                        ForceChoice::ZeemanTotal})
-    if (name == force_choice_name(f)) {
-      *out = f;
-      return true;
-    }
-  return false;
-}
+inline bool parse_space(const std::string& name, SpaceKind* out) { return kSpaceNames.parse(name, out); }
 
 /// Run options. Defaults are the engine's; each scene overrides what it needs.
 struct SimOptions {
-  /// The magnetization solve. The default, Anderson-accelerated M = f(H(M)) with the classic
-  /// force, converges every rigid (sub-)step and makes the force −∇U* (magnetics/coenergy.hpp):
-  /// passive scenes lose energy and come to rest. `ours` is the paper as printed (θ dynamics
-  /// eqs. 8–11, eq. 4), whose force has no energy.
-  mag::Method method = mag::Method::Anderson;
-  /// Δt_m, β, tolerance, cap … (method is set from above). Scenes stop the sweeps when the
-  /// residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::criterion, default Residual)
-  /// or after 100 sweeps per rigid step: warm-started from the last step, a converging method
-  /// needs a handful; a cap hit is counted in the profile.
+  /// The magnetization solve: its method, Δt_m, β, tolerance, cap … The method (the scene
+  /// file's top-level "method") defaults to anderson: Anderson-accelerated M = f(H(M)) with
+  /// the classic force converges every rigid (sub-)step and makes the force −∇U*
+  /// (magnetics/coenergy.hpp), so passive scenes lose energy and come to rest. `ours` is the
+  /// paper as printed (θ dynamics eqs. 8–11, eq. 4), whose force has no energy. Scenes stop
+  /// the sweeps when the residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::
+  /// criterion, default Residual) or after 100 sweeps per rigid step: warm-started from the
+  /// last step, a converging method needs a handful; a cap hit is counted in the profile.
   mag::DynamicsOptions magnetics = [] {
     mag::DynamicsOptions d;
+    d.method = mag::Method::Anderson;
     d.tol = 1e-4;
     d.max_iter = 100;
     return d;
@@ -147,8 +110,9 @@ struct SimOptions {
   /// changes neither the balls thrown at the landing nor the control's rest
   /// (tools/findings/falling_magnet.md).
   bool balance_magnetic_torque = false;
-  /// The force on induced moments (method = the method's own pairing, the default).
-  ForceChoice force_model = ForceChoice::Method;
+  /// The force on induced moments; Method (the default) is the method's own pairing
+  /// (resolved_force_model below).
+  mag::ForceModel force_model = mag::ForceModel::Method;
   /// Energy guard, for conservative forces (classic, zeeman-total; eq. 4 has no energy and is
   /// never guarded): a rigid step whose E = K + U_g + U* rises by more than
   ///   energy_guard_tolerance · (K_start + K_end + |U*_start|) + energy_guard_floor
@@ -228,25 +192,10 @@ struct SimOptions {
   double max_body_speed = 1000.0;
 };
 
-/// The force on induced moments that `o` resolves to (ForceChoice::Method: the method's own
-/// pairing, mag::force_model_of).
+/// The force on induced moments that `o` resolves to (mag::resolve_force_model): never
+/// ForceModel::Method.
 inline mag::ForceModel resolved_force_model(const SimOptions& o) {
-  switch (o.force_model) {
-    case ForceChoice::Zeeman: return mag::ForceModel::Zeeman;
-    case ForceChoice::Classic: return mag::ForceModel::Classic;
-    case ForceChoice::ZeemanTotal: return mag::ForceModel::ZeemanTotal;
-    case ForceChoice::Method: break;
-  }
-  return mag::force_model_of(o.method);
-}
-/// A resolved force in --force-model's spelling: "zeeman" (eq. 4), "classic", "zeeman-total".
-inline const char* force_model_name(mag::ForceModel f) {
-  switch (f) {
-    case mag::ForceModel::Zeeman: return "zeeman";
-    case mag::ForceModel::Classic: return "classic";
-    case mag::ForceModel::ZeemanTotal: return "zeeman-total";
-  }
-  return "?";
+  return mag::resolve_force_model(o.force_model, o.magnetics.method);
 }
 /// The resolved force is the gradient of an energy (classic: −∇U*; zeeman-total: −∇E_sys), so
 /// the energy guard can check it. eq. 4 (zeeman) is not.

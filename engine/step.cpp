@@ -55,9 +55,9 @@ double Simulation::coenergy(const mag::Magnetization& mz) const {
   if (ws_.mag.H.size() != moments_.size()) return 0.0;
   // the potential of the force where it has its own (zeeman-total: E_sys, forces.hpp)
   if (resolved_force_model(m.options) == mag::ForceModel::ZeemanTotal)
-    return mag::zeeman_total_energy(moments_, mz, mag::curve_of(m.options.method), ws_.mag.H,
+    return mag::zeeman_total_energy(moments_, mz, mag::curve_of(m.options.magnetics.method), ws_.mag.H,
                                     ws_.mag.total.perm, ws_.mag.total.Hp);
-  return mag::magnetic_coenergy(moments_, mz, mag::curve_of(m.options.method), ws_.mag.H);
+  return mag::magnetic_coenergy(moments_, mz, mag::curve_of(m.options.magnetics.method), ws_.mag.H);
 }
 
 void Simulation::solve_magnetics(mag::Magnetization* mz, bool solve, long n) {

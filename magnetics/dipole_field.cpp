@@ -45,25 +45,6 @@ Vec3 bounded_separation(const Vec3& r, double R) {
   return d < R && d > 0 ? Vec3(r * (R / d)) : r;
 }
 
-const char* field_solver_name(FieldSolver s) {
-  switch (s) {
-    case FieldSolver::Direct: return "direct";
-    case FieldSolver::BarnesHut: return "barnes-hut";
-    case FieldSolver::Auto: return "auto";
-  }
-  return "?";
-}
-
-bool parse_field_solver(const std::string& name, FieldSolver* out) {
-  for (FieldSolver s : {FieldSolver::Direct, FieldSolver::BarnesHut, FieldSolver::Auto}) {
-    if (name == field_solver_name(s)) {
-      *out = s;
-      return true;
-    }
-  }
-  return false;
-}
-
 std::string validate(const FieldOptions& o) {
   std::ostringstream e;
   if (!(o.softening >= 0 && std::isfinite(o.softening)))

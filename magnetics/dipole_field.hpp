@@ -14,6 +14,8 @@ enum class FieldSolver : std::uint8_t {
   BarnesHut,  ///< octree far-field approximation (magnetics/barnes_hut.hpp), error set by θ
   Auto        ///< Direct below auto_threshold moments, Barnes–Hut from there on
 };
+inline constexpr NameTable<FieldSolver, 3> kFieldSolverNames{
+    {{FieldSolver::Direct, "direct"}, {FieldSolver::BarnesHut, "barnes-hut"}, {FieldSolver::Auto, "auto"}}};
 
 struct FieldOptions {
   /// Softening length ε (m): |r|² → |r|² + ε² in the field and, consistently, in its
@@ -62,10 +64,13 @@ struct FieldOptions {
   bool bh_far_float = true;
 };
 
-/// "direct", "barnes-hut", "auto".
-const char* field_solver_name(FieldSolver s);
-/// Parses a solver name; returns false (and leaves *out alone) on an unknown name.
-bool parse_field_solver(const std::string& name, FieldSolver* out);
+/// A solver's name in kFieldSolverNames.
+inline const char* field_solver_name(FieldSolver s) { return kFieldSolverNames.name(s); }
+/// Parses a solver name (kFieldSolverNames); returns false (and leaves *out alone) on an
+/// unknown name.
+inline bool parse_field_solver(const std::string& name, FieldSolver* out) {
+  return kFieldSolverNames.parse(name, out);
+}
 /// Empty when the field options are usable, else a one-line reason.
 std::string validate(const FieldOptions& opt);
 

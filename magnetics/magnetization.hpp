@@ -13,6 +13,8 @@ enum class ThetaIntegrator : std::uint8_t {
   Exact,  ///< closed form for constant |H_eff| (default; cannot overshoot θ = 0)
   Euler   ///< the paper's literal explicit step θ ← max(0, θ − Δt β |H_eff| Θ(θ))
 };
+inline constexpr NameTable<ThetaIntegrator, 2> kThetaIntegratorNames{
+    {{ThetaIntegrator::Exact, "exact"}, {ThetaIntegrator::Euler, "euler"}}};
 
 struct DynamicsOptions {
   Method method = Method::Ours;
@@ -49,6 +51,8 @@ struct DynamicsOptions {
   double anderson_restart_growth = 2.0;
   FieldOptions field;
 };
+inline constexpr NameTable<DynamicsOptions::Criterion, 2> kCriterionNames{
+    {{DynamicsOptions::Criterion::Residual, "residual"}, {DynamicsOptions::Criterion::Change, "change"}}};
 
 /// Empty when the options are usable, else a one-line reason.
 std::string validate(const DynamicsOptions& opt);

@@ -7,29 +7,6 @@
 
 namespace magsim::mag {
 
-const char* method_name(Method m) {
-  switch (m) {
-    case Method::Ours: return "ours";
-    case Method::OursRealigned: return "ours-realigned";
-    case Method::Kim2018: return "kim2018";
-    case Method::DampingLLG: return "damping-llg";
-    case Method::Exact: return "exact";
-    case Method::Anderson: return "anderson";
-  }
-  return "?";
-}
-
-bool parse_method(const std::string& name, Method* out) {
-  for (Method m : {Method::Ours, Method::OursRealigned, Method::Kim2018, Method::DampingLLG,
-                   Method::Exact, Method::Anderson}) {
-    if (name == method_name(m)) {
-      *out = m;
-      return true;
-    }
-  }
-  return false;
-}
-
 Vec3 any_perpendicular(const Vec3& u) {
   // cross with the coordinate axis least aligned with u
   Vec3 a = Vec3::UnitX();

@@ -2,6 +2,8 @@
 // SI units throughout: metres, A/m for H and M, A·m² for moments, newtons, seconds.
 #pragma once
 
+#include "magnetics/names.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -21,21 +23,39 @@ enum class MomentKind : std::uint8_t { Induced, Permanent };
 /// Magnetization dynamics / solver. Exact is the Newton ground truth (no dynamics);
 /// Anderson solves M = f(H(M)) by Anderson-accelerated Picard iteration (beyond the paper).
 enum class Method : std::uint8_t { Ours, OursRealigned, Kim2018, DampingLLG, Exact, Anderson };
+inline constexpr NameTable<Method, 6> kMethodNames{{{Method::Ours, "ours"},
+                                                    {Method::OursRealigned, "ours-realigned"},
+                                                    {Method::Kim2018, "kim2018"},
+                                                    {Method::DampingLLG, "damping-llg"},
+                                                    {Method::Exact, "exact"},
+                                                    {Method::Anderson, "anderson"}}};
 
 /// Magnetization curve M = f(H).
 enum class Curve : std::uint8_t {
   Tanh,  ///< ours, eq. 10: f(H) = Ms tanh(3|H|/Ms) H/|H|
   Kim    ///< Kim 2018, eq. 7: M = H/γ_D below saturation, Ms H/|H| above (γ_D = 1/3)
 };
+inline constexpr NameTable<Curve, 2> kCurveNames{{{Curve::Tanh, "tanh"}, {Curve::Kim, "kim"}}};
 
 /// Force model for induced moments.
 enum class ForceModel : std::uint8_t {
-  Zeeman,  ///< ours, eq. 4 (M varies with H), each moment's gradient with the sources fixed
-  Classic,  ///< eqs. 13–14 (m held constant)
+  /// The method's own pairing (force_model_of): classic for anderson, exact and kim2018,
+  /// eq. 4 for ours, ours-realigned and damping-llg. An option's default, which
+  /// resolve_force_model replaces before any force is computed.
+  Method,
+  /// ours, eq. 4 (M varies with H): F = μ0 V J [A (2M + H) + M], each moment's gradient with
+  /// the sources fixed; 2(χ+1) ≈ 8× classic in the linear range
+  Zeeman,
+  Classic,  ///< eqs. 13–14: F = μ0 J m, m held constant
   /// eq. 4 as the gradient of the system's Zeeman energy with every magnetization a variable
-  /// (forces.hpp, compute_forces): conservative, momentum-conserving
+  /// (forces.hpp, compute_forces): conservative, momentum-conserving; compute_forces'
+  /// reaction-symmetric pairing has no effect on it
   ZeemanTotal
 };
+inline constexpr NameTable<ForceModel, 4> kForceModelNames{{{ForceModel::Method, "method"},
+                                                            {ForceModel::Zeeman, "zeeman"},
+                                                            {ForceModel::Classic, "classic"},
+                                                            {ForceModel::ZeemanTotal, "zeeman-total"}}};
 
 /// The curve a method converges to (Kim 2018 uses eq. 7, every other method eq. 10).
 inline Curve curve_of(Method m) { return m == Method::Kim2018 ? Curve::Kim : Curve::Tanh; }
@@ -52,9 +72,14 @@ inline ForceModel force_model_of(Method m) {
   }
 }
 
-/// "ours", "ours-realigned", "kim2018", "damping-llg", "exact", "anderson".
-const char* method_name(Method m);
-/// Parses a method name; returns false (and leaves *out alone) on an unknown name.
-bool parse_method(const std::string& name, Method* out);
+/// The force `chosen` with ForceModel::Method replaced by the method's own pairing.
+inline ForceModel resolve_force_model(ForceModel chosen, Method m) {
+  return chosen == ForceModel::Method ? force_model_of(m) : chosen;
+}
+
+/// A method's name in kMethodNames.
+inline const char* method_name(Method m) { return kMethodNames.name(m); }
+/// Parses a method name (kMethodNames); returns false (and leaves *out alone) on an unknown name.
+inline bool parse_method(const std::string& name, Method* out) { return kMethodNames.parse(name, out); }
 
 }  // namespace magsim::mag

@@ -4,6 +4,7 @@
 // so magsolve (magnetics only) and the scene loader share it.
 #pragma once
 
+#include "magnetics/names.hpp"
 #include "render/frame.hpp"
 #include "scenes/option_ranges.hpp"
 
@@ -94,6 +95,15 @@ class JsonReader {
   std::string string(const nlohmann::json& j, const std::string& path) const {
     if (!j.is_string()) fail(path, "must be a string");
     return j.get<std::string>();
+  }
+  /// A string that names a value in `table`; an unknown name fails with the valid names.
+  template <class E, std::size_t N>
+  E named(const nlohmann::json& j, const std::string& path, const mag::NameTable<E, N>& table,
+          const char* what) const {
+    const std::string s = string(j, path);
+    E v{};
+    if (!table.parse(s, &v)) fail(path, table.unknown(what, s));
+    return v;
   }
 
   // arrays of numbers

@@ -10,48 +10,7 @@
 namespace magsim::scenes {
 
 using engine::SimOptions;
-using engine::SpaceKind;
 using json = nlohmann::json;
-
-const std::vector<std::string>& method_names() {
-  // mag::Method numbers its enumerators from 0 and method_name answers "?" past the last:
-  // the list follows magnetics/moments.cpp's table without a copy of it
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> v;
-    for (int i = 0; i < 256; ++i) {
-      const std::string n = mag::method_name(static_cast<mag::Method>(i));
-      if (n == "?") break;
-      v.push_back(n);
-    }
-    return v;
-  }();
-  return names;
-}
-
-std::string method_list(const char* sep) {
-  std::string s;
-  for (const std::string& n : method_names()) s += (s.empty() ? "" : sep) + n;
-  return s;
-}
-
-namespace {
-
-SpaceKind space_kind(const JsonReader& r, const json& j, const std::string& path) {
-  const std::string s = r.string(j, path);
-  SpaceKind k;
-  if (engine::parse_space(s, &k)) return k;
-  r.fail(path, "unknown space '" + s + "' (hash, sap, simple)");
-}
-
-mag::Method method(const JsonReader& r, const json& j, const std::string& path) {
-  const std::string s = r.string(j, path);
-  mag::Method m;
-  if (!mag::parse_method(s, &m))
-    r.fail(path, "unknown method '" + s + "' (" + method_list() + ")");
-  return m;
-}
-
-}  // namespace
 
 json to_json(const mag::DynamicsOptions& d) {
   return json{{"dt", d.dt},
@@ -61,10 +20,10 @@ json to_json(const mag::DynamicsOptions& d) {
               {"adaptive_gamma_bound", d.adaptive_gamma_bound},
               {"adaptive_gamma_cap", d.adaptive_gamma_cap},
               {"tol", d.tol},
-              {"criterion", d.criterion == mag::DynamicsOptions::Criterion::Residual ? "residual" : "change"},
+              {"criterion", mag::kCriterionNames.name(d.criterion)},
               {"max_iter", d.max_iter},
               {"min_pair_angle", d.min_pair_angle},
-              {"theta_integrator", d.theta_integrator == mag::ThetaIntegrator::Exact ? "exact" : "euler"},
+              {"theta_integrator", mag::kThetaIntegratorNames.name(d.theta_integrator)},
               {"anderson_depth", d.anderson_depth},
               {"anderson_damping", d.anderson_damping},
               {"anderson_restart_growth", d.anderson_restart_growth},
@@ -74,7 +33,7 @@ json to_json(const mag::DynamicsOptions& d) {
 
 json to_json(const SimOptions& o) {
   const mag::FieldOptions& f = o.magnetics.field;
-  return json{{"method", mag::method_name(o.method)},
+  return json{{"method", mag::method_name(o.magnetics.method)},
               {"dt", o.dt},
               {"gravity", vec3_json(o.gravity)},
               {"ground", o.ground},
@@ -95,7 +54,7 @@ json to_json(const SimOptions& o) {
               {"threads", o.threads},
               {"reaction_symmetric_forces", o.reaction_symmetric_forces},
               {"balance_magnetic_torque", o.balance_magnetic_torque},
-              {"force_model", engine::force_choice_name(o.force_model)},
+              {"force_model", mag::kForceModelNames.name(o.force_model)},
               {"energy_guard", o.energy_guard},
               {"energy_guard_tolerance", o.energy_guard_tolerance},
               {"energy_guard_floor", o.energy_guard_floor},
@@ -132,16 +91,10 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, mag:
   if_present(j, "max_iter", path, [&](const json& v, const std::string& p) { d->max_iter = static_cast<int>(r.option(v, p, option_range("magnetics.max_iter"))); });
   if_present(j, "min_pair_angle", path, [&](const json& v, const std::string& p) { d->min_pair_angle = r.in_range(v, p, 1e-300, 0.0099999); });
   if_present(j, "theta_integrator", path, [&](const json& v, const std::string& p) {
-    const std::string s = r.string(v, p);
-    if (s == "exact") d->theta_integrator = mag::ThetaIntegrator::Exact;
-    else if (s == "euler") d->theta_integrator = mag::ThetaIntegrator::Euler;
-    else r.fail(p, "unknown theta integrator '" + s + "' (exact, euler)");
+    d->theta_integrator = r.named(v, p, mag::kThetaIntegratorNames, "theta integrator");
   });
   if_present(j, "criterion", path, [&](const json& v, const std::string& p) {
-    const std::string s = r.string(v, p);
-    if (s == "residual") d->criterion = mag::DynamicsOptions::Criterion::Residual;
-    else if (s == "change") d->criterion = mag::DynamicsOptions::Criterion::Change;
-    else r.fail(p, "unknown criterion '" + s + "' (residual, change)");
+    d->criterion = r.named(v, p, mag::kCriterionNames, "criterion");
   });
   if_present(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.option(v, p, option_range("magnetics.softening")); });
   if_present(j, "bounded_pairs", path, [&](const json& v, const std::string& p) { d->field.bounded_pairs = r.boolean(v, p); });
@@ -162,7 +115,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
                    "bh_near_float", "bh_far_float", "energy_guard", "energy_guard_tolerance",
                    "energy_guard_floor", "energy_guard_max_substeps"});
-  if_present(j, "method", path, [&](const json& v, const std::string& p) { o->method = method(r, v, p); });
+  if_present(j, "method", path, [&](const json& v, const std::string& p) { o->magnetics.method = r.named(v, p, mag::kMethodNames, "method"); });
   if_present(j, "dt", path, [&](const json& v, const std::string& p) {
     o->dt = r.option(v, p, option_range("dt"));
   });
@@ -174,7 +127,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "cfm", path, [&](const json& v, const std::string& p) { o->cfm = r.non_negative(v, p); });
   if_present(j, "quickstep_iterations", path, [&](const json& v, const std::string& p) { o->quickstep_iterations = static_cast<int>(r.option(v, p, option_range("quickstep_iterations"))); });
   if_present(j, "max_contacts", path, [&](const json& v, const std::string& p) { o->max_contacts = r.integer(v, p, 1, 64); });
-  if_present(j, "space", path, [&](const json& v, const std::string& p) { o->space = space_kind(r, v, p); });
+  if_present(j, "space", path, [&](const json& v, const std::string& p) { o->space = r.named(v, p, engine::kSpaceNames, "space"); });
   if_present(j, "auto_disable", path, [&](const json& v, const std::string& p) { o->auto_disable = r.boolean(v, p); });
   if_present(j, "linear_damping", path, [&](const json& v, const std::string& p) { o->linear_damping = r.non_negative(v, p); });
   if_present(j, "angular_damping", path, [&](const json& v, const std::string& p) { o->angular_damping = r.non_negative(v, p); });
@@ -183,8 +136,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
   if_present(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = static_cast<int>(r.option(v, p, option_range("threads"))); });
   if_present(j, "force_model", path, [&](const json& v, const std::string& p) {
-    const std::string s = r.string(v, p);
-    if (!engine::parse_force_choice(s, &o->force_model)) r.fail(p, "unknown force model '" + s + "' (method, zeeman, classic, zeeman-total)");
+    o->force_model = r.named(v, p, mag::kForceModelNames, "force model");
   });
   if_present(j, "energy_guard", path, [&](const json& v, const std::string& p) { o->energy_guard = r.boolean(v, p); });
   if_present(j, "energy_guard_tolerance", path, [&](const json& v, const std::string& p) { o->energy_guard_tolerance = r.option(v, p, option_range("energy_guard_tolerance")); });
@@ -205,8 +157,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "balance_magnetic_torque", path, [&](const json& v, const std::string& p) { o->balance_magnetic_torque = r.boolean(v, p); });
   mag::FieldOptions& f = o->magnetics.field;
   if_present(j, "field_solver", path, [&](const json& v, const std::string& p) {
-    const std::string s = r.string(v, p);
-    if (!mag::parse_field_solver(s, &f.solver)) r.fail(p, "unknown field solver '" + s + "' (direct, barnes-hut, auto)");
+    f.solver = r.named(v, p, mag::kFieldSolverNames, "field solver");
   });
   if_present(j, "bh_theta", path, [&](const json& v, const std::string& p) {
     f.bh_theta = r.option(v, p, option_range("bh_theta"));
@@ -219,7 +170,6 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "bh_far_float", path, [&](const json& v, const std::string& p) { f.bh_far_float = r.boolean(v, p); });
   if_present(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
   if_present(j, "magnetics", path, [&](const json& v, const std::string& p) { from_json(r, v, p, &o->magnetics); });
-  o->magnetics.method = o->method;
 }
 
 }  // namespace magsim::scenes

@@ -17,8 +17,8 @@ namespace magsim::scenes {
 
 /// Every SimOptions field under its scene-file name ("dt", "space", "magnetics": {…}, …).
 nlohmann::json to_json(const engine::SimOptions& o);
-/// The "magnetics" object: every DynamicsOptions field but the method (SimOptions::method
-/// holds it), with FieldOptions' softening and bounded_pairs (the other field options sit
+/// The "magnetics" object: every DynamicsOptions field but the method (the options' top-level
+/// "method" holds it), with FieldOptions' softening and bounded_pairs (the other field options sit
 /// beside it in "options": field_solver, bh_theta, bh_threshold, bh_*).
 nlohmann::json to_json(const mag::DynamicsOptions& d);
 
@@ -30,10 +30,5 @@ void from_json(const JsonReader& r, const nlohmann::json& j, const std::string& 
 
 /// [x, y, z]: how scene files, summary.json and the options write a vector.
 inline nlohmann::json vec3_json(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
-
-/// Every method name, in the order of mag::Method, from mag::method_name (the one table).
-const std::vector<std::string>& method_names();
-/// "a, b, c" of method_names(), for messages and help.
-std::string method_list(const char* sep = ", ");
 
 }  // namespace magsim::scenes

@@ -87,20 +87,11 @@ using json = nlohmann::json;
 namespace {
 
 ShapeKind shape_kind(const JsonReader& r, const json& j, const std::string& path) {
-  const std::string s = r.string(j, path);
-  if (s == "sphere") return ShapeKind::Sphere;
-  if (s == "box") return ShapeKind::Box;
-  if (s == "capsule") return ShapeKind::Capsule;
-  if (s == "cylinder") return ShapeKind::Cylinder;
-  r.fail(path, "unknown shape kind '" + s + "' (sphere, box, capsule, cylinder)");
+  return r.named(j, path, engine::kShapeKindNames, "shape kind");
 }
 
 BodyType body_type(const JsonReader& r, const json& j, const std::string& path) {
-  const std::string s = r.string(j, path);
-  if (s == "dynamic") return BodyType::Dynamic;
-  if (s == "kinematic") return BodyType::Kinematic;
-  if (s == "static") return BodyType::Static;
-  r.fail(path, "unknown body type '" + s + "' (dynamic, kinematic, static)");
+  return r.named(j, path, engine::kBodyTypeNames, "body type");
 }
 
 Vec3 shape_size(const JsonReader& r, ShapeKind kind, const json& j, const std::string& path) {
@@ -334,25 +325,6 @@ namespace {
 json vec3f(const Eigen::Vector3f& v) { return json::array({v.x(), v.y(), v.z()}); }
 json quat(const Quat& q) { return json::array({q.w(), q.x(), q.y(), q.z()}); }
 
-const char* shape_kind_name(ShapeKind k) {
-  switch (k) {
-    case ShapeKind::Sphere: return "sphere";
-    case ShapeKind::Box: return "box";
-    case ShapeKind::Capsule: return "capsule";
-    case ShapeKind::Cylinder: return "cylinder";
-  }
-  return "?";
-}
-
-const char* body_type_name(BodyType t) {
-  switch (t) {
-    case BodyType::Dynamic: return "dynamic";
-    case BodyType::Kinematic: return "kinematic";
-    case BodyType::Static: return "static";
-  }
-  return "?";
-}
-
 json shape_json(const ShapeDesc& sh) {
   json size;
   switch (sh.kind) {
@@ -361,7 +333,7 @@ json shape_json(const ShapeDesc& sh) {
     case ShapeKind::Capsule:
     case ShapeKind::Cylinder: size = json::array({sh.size.x(), sh.size.y()}); break;
   }
-  return json{{"kind", shape_kind_name(sh.kind)}, {"offset", vec3_json(sh.offset)}, {"rotation", quat(sh.rotation)},
+  return json{{"kind", engine::kShapeKindNames.name(sh.kind)}, {"offset", vec3_json(sh.offset)}, {"rotation", quat(sh.rotation)},
               {"size", size}};
 }
 
@@ -378,7 +350,7 @@ json body_json(const BodyDesc& b) {
   for (const ShapeDesc& sh : b.shapes) shapes.push_back(shape_json(sh));
   for (const MomentDesc& m : b.moments) moments.push_back(moment_json(m));
   return json{{"name", b.name},
-              {"type", body_type_name(b.type)},
+              {"type", engine::kBodyTypeNames.name(b.type)},
               {"position", vec3_json(b.position)},
               {"orientation", quat(b.orientation)},
               {"velocity", vec3_json(b.velocity)},

@@ -72,7 +72,7 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   magsim::scenes::SceneParams p;
   p.count = count;
   eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
-  d.options.method = method;
+  d.options.magnetics.method = method;
   if (threads > 0) d.options.threads = threads;
   field.apply(&d.options.magnetics.field);
   if (solver) d.options.magnetics.field.solver = *solver;
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
   app.add_option("--scaling-methods", scaling_methods, "methods for the scaling runs")->capture_default_str();
   app.add_option("--scaling-steps", scaling_steps, "window of each scaling run")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--scaling-warmup", scaling_warmup, "steps before each scaling window")->check(CLI::NonNegativeNumber)->capture_default_str();
-  field.add(&app, "direct | barnes-hut | auto: dipole-field summation of every run (default: the scene's, auto)");
+  field.add(&app, mag::kFieldSolverNames.list(" | ") + ": dipole-field summation of every run (default: the scene's, auto)");
   app.add_option("--scaling-solver", scaling_solver,
                  "field solver of the scaling runs (default auto, or --field-solver when only that is given)")
       ->capture_default_str();
@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
   for (const std::string& m : split(methods)) {
     mag::Method x;
     if (!mag::parse_method(m, &x)) {
-      std::fprintf(stderr, "bench: unknown method '%s'\n", m.c_str());
+      std::fprintf(stderr, "bench: %s\n", mag::kMethodNames.unknown("method", m).c_str());
       return 2;
     }
     ms.emplace_back(m, x);

@@ -1,5 +1,5 @@
 // tools/field_flags.hpp — the dipole-field flags shared by magsim-scene and bench:
-// --field-solver direct|barnes-hut|auto, --bh-theta θ, --bh-threshold N. Flags not given
+// --field-solver (mag::kFieldSolverNames), --bh-theta θ, --bh-threshold N. Flags not given
 // leave the scene's FieldOptions as they are.
 #pragma once
 
@@ -37,7 +37,7 @@ struct FieldFlags {
   static mag::FieldSolver parse(const std::string& name, const char* flag) {
     mag::FieldSolver s;
     if (!mag::parse_field_solver(name, &s))
-      throw std::invalid_argument(std::string(flag) + ": unknown solver '" + name + "' (direct, barnes-hut, auto)");
+      throw std::invalid_argument(std::string(flag) + ": " + mag::kFieldSolverNames.unknown("solver", name));
     return s;
   }
 

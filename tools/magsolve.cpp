@@ -156,7 +156,7 @@ int run(int argc, char** argv) {
                  "CASE.json: {\"external_field\": [Hx,Hy,Hz], \"moments\": [...], \"magnetics\": {...}} "
                  "(magnetics: a scene file's options.magnetics; the flags below override it)")
       ->required();
-  app.add_option("--method", method_name, magsim::scenes::method_list("|"))->capture_default_str();
+  app.add_option("--method", method_name, mag::kMethodNames.list("|"))->capture_default_str();
   app.add_option("--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6]")
       ->check(magsim::tools::OptionCheck("magnetics.dt"))->capture_default_str();
   app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration, in (0, 1)")
@@ -195,8 +195,7 @@ int run(int argc, char** argv) {
   }
   mag::DynamicsOptions opt;
   if (!mag::parse_method(method_name, &opt.method)) {
-    std::fprintf(stderr, "magsolve: unknown method '%s' (%s)\n", method_name.c_str(),
-                 magsim::scenes::method_list().c_str());
+    std::fprintf(stderr, "magsolve: %s\n", mag::kMethodNames.unknown("method", method_name).c_str());
     return kBadInput;
   }
   mag::MomentSet set;
@@ -342,7 +341,8 @@ int run(int argc, char** argv) {
     out["residual"] = {{"max", residual}, {"moment", worst}, {"tol", residual_tol}};
     out["e_M"] = eM;
     out["wall_ms"] = wall_ms;
-    out["ground_truth"] = {{"curve", curve == mag::Curve::Tanh ? "tanh (eq. 10)" : "kim (eq. 7)"},
+    out["ground_truth"] = {{"curve", std::string(mag::kCurveNames.name(curve)) +
+                                                     (curve == mag::Curve::Tanh ? " (eq. 10)" : " (eq. 7)")},
                            {"newton_steps", gts.newton_steps},
                            {"residual", gts.residual},
                            {"converged", gts.converged}};

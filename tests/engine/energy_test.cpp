@@ -201,7 +201,7 @@ double zeeman_total_work_error(double dt) {
   s.options.dt = dt;
   s.options.gravity = Vec3::Zero();
   s.options.ground = false;
-  s.options.force_model = engine::ForceChoice::ZeemanTotal;
+  s.options.force_model = mag::ForceModel::ZeemanTotal;
   s.bodies.push_back(cube_magnet(Vec3::Zero(), Vec3(0, 0, 1.0)));
   s.bodies.push_back(iron_ball("a", Vec3(0.0, 0.0, -0.04)));
   s.bodies.push_back(iron_ball("b", Vec3(0.013, 0.0, -0.043)));

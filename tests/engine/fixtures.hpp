@@ -39,7 +39,7 @@ inline BodyDesc iron_ball(const std::string& name, const Vec3& p, double r = kR)
 inline SceneDesc free_space(const std::string& name) {
   SceneDesc s;
   s.name = name;
-  s.options.method = mag::Method::OursRealigned;
+  s.options.magnetics.method = mag::Method::OursRealigned;
   s.options.threads = 1;
   s.options.gravity = Vec3::Zero();
   s.options.ground = false;
@@ -69,7 +69,7 @@ inline BodyDesc cube_magnet(const Vec3& p, const Vec3& m) {
 inline SceneDesc pile_under_magnet(int n, double strength = 1.0) {
   SceneDesc s;
   s.name = "pile";
-  s.options.method = mag::Method::OursRealigned;
+  s.options.magnetics.method = mag::Method::OursRealigned;
   s.options.threads = 1;
   s.options.magnetics.max_iter = 200;
   const double pitch = 2.05 * kR;

@@ -1,6 +1,6 @@
 // tests/engine/options_json_test.cpp — the run options as JSON (scenes/options_json.cpp):
 // every field written and read back equal, the scene file reads the same spelling, and the
-// method list is the method table's.
+// names of every enum round-trip through its one table.
 #include "engine/simulation.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/registry.hpp"
@@ -8,7 +8,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <set>
 #include <string>
+#include <vector>
 
 using namespace magsim;
 using engine::SimOptions;
@@ -19,9 +21,8 @@ namespace {
 // Every field away from its default (and from the registry scenes' values).
 SimOptions all_changed() {
   SimOptions o;
-  o.method = mag::Method::Anderson;
   mag::DynamicsOptions& d = o.magnetics;
-  d.method = o.method;
+  d.method = mag::Method::Kim2018;
   d.dt = 7.3e-8;
   d.beta = 4.25;
   d.alpha = 0.23;
@@ -49,7 +50,7 @@ SimOptions all_changed() {
   f.bh_far_float = false;
   o.reaction_symmetric_forces = true;
   o.balance_magnetic_torque = true;
-  o.force_model = engine::ForceChoice::Classic;
+  o.force_model = mag::ForceModel::Classic;
   o.dt = 5e-4;
   o.max_substeps = 6;
   o.substep_reach = 0.4;
@@ -86,7 +87,7 @@ SimOptions all_changed() {
 void check_equal(const SimOptions& a, const SimOptions& b) {
   const mag::DynamicsOptions &da = a.magnetics, &db = b.magnetics;
   const mag::FieldOptions &fa = da.field, &fb = db.field;
-  CHECK(a.method == b.method);  // magnetics.method is not an option: the engine sets it from this
+  CHECK(da.method == db.method);  // the options' top-level "method"
   CHECK(da.dt == db.dt);
   CHECK(da.beta == db.beta);
   CHECK(da.alpha == db.alpha);
@@ -157,7 +158,7 @@ SimOptions read_back(const nlohmann::json& j) {
 // all_changed and check_equal above (and SCENE_FILE.md), then update the size here.
 static_assert(sizeof(mag::FieldOptions) == 48, "FieldOptions changed: extend scenes/options_json.cpp");
 static_assert(sizeof(mag::DynamicsOptions) == 152, "DynamicsOptions changed: extend scenes/options_json.cpp");
-static_assert(sizeof(SimOptions) == 408, "SimOptions changed: extend scenes/options_json.cpp");
+static_assert(sizeof(SimOptions) == 392, "SimOptions changed: extend scenes/options_json.cpp");
 
 TEST_CASE("options_json: every field, away from its default, survives to_json and from_json", "[options_json]") {
   const SimOptions o = all_changed();
@@ -185,15 +186,70 @@ TEST_CASE("options_json: a bad value names its JSON path", "[options_json]") {
   CHECK_THROWS_WITH(read_back(j), Catch::Matchers::Contains("options.dt_m: unknown key"));
 }
 
-TEST_CASE("options_json: the method list is every name mag::parse_method accepts", "[options_json]") {
-  const std::vector<std::string>& names = scenes::method_names();
-  CHECK(names.size() == 6);
-  for (const std::string& n : names) {
-    mag::Method m;
-    REQUIRE(mag::parse_method(n, &m));
-    CHECK(mag::method_name(m) == n);
+// One enum's table: every value 0..N-1 has one name, which parses back to it; an unknown name
+// is refused (the value left alone) with a message that lists the valid names.
+template <class E, std::size_t N>
+void check_names(const mag::NameTable<E, N>& t, const std::string& what) {
+  INFO(what);
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < N; ++i) {
+    const E v = static_cast<E>(i);
+    const std::string n = t.name(v);
+    CHECK(n != "?");
+    CHECK(seen.insert(n).second);
+    E back = static_cast<E>(N);
+    REQUIRE(t.parse(n, &back));
+    CHECK(back == v);
+    CHECK(std::string(t.name(back)) == n);
   }
-  CHECK(scenes::method_list() == "ours, ours-realigned, kim2018, damping-llg, exact, anderson");
+  CHECK(std::string(t.name(static_cast<E>(N))) == "?");
+  const std::vector<std::string> names = t.names();
+  CHECK(std::set<std::string>(names.begin(), names.end()) == seen);
+  E kept = static_cast<E>(0);
+  CHECK_FALSE(t.parse("no-such-name", &kept));
+  CHECK(kept == static_cast<E>(0));
+  CHECK(t.unknown(what.c_str(), "no-such-name") == "unknown " + what + " 'no-such-name' (" + t.list() + ")");
+}
+
+TEST_CASE("names: every enum's values round-trip through its one table", "[options_json]") {
+  check_names(mag::kMethodNames, "method");
+  check_names(mag::kCurveNames, "curve");
+  check_names(mag::kForceModelNames, "force model");
+  check_names(mag::kFieldSolverNames, "field solver");
+  check_names(mag::kThetaIntegratorNames, "theta integrator");
+  check_names(mag::kCriterionNames, "criterion");
+  check_names(engine::kSpaceNames, "space");
+  check_names(engine::kShapeKindNames, "shape kind");
+  check_names(engine::kBodyTypeNames, "body type");
+  CHECK(mag::kMethodNames.list() == "ours, ours-realigned, kim2018, damping-llg, exact, anderson");
+  CHECK(mag::kForceModelNames.list() == "method, zeeman, classic, zeeman-total");
+}
+
+TEST_CASE("names: the scene file refuses an unknown name with the path and the valid names", "[options_json]") {
+  struct Case {
+    const char* json;
+    const char* says;
+  };
+  const Case cases[] = {
+      {R"({"options": {"method": "x"}, "bodies": []})",
+       "options.method: unknown method 'x' (ours, ours-realigned, kim2018, damping-llg, exact, anderson)"},
+      {R"({"options": {"force_model": "x"}, "bodies": []})",
+       "options.force_model: unknown force model 'x' (method, zeeman, classic, zeeman-total)"},
+      {R"({"options": {"space": "x"}, "bodies": []})", "options.space: unknown space 'x' (hash, sap, simple)"},
+      {R"({"options": {"field_solver": "x"}, "bodies": []})",
+       "options.field_solver: unknown field solver 'x' (direct, barnes-hut, auto)"},
+      {R"({"options": {"magnetics": {"criterion": "x"}}, "bodies": []})",
+       "options.magnetics.criterion: unknown criterion 'x' (residual, change)"},
+      {R"({"options": {"magnetics": {"theta_integrator": "x"}}, "bodies": []})",
+       "options.magnetics.theta_integrator: unknown theta integrator 'x' (exact, euler)"},
+      {R"({"bodies": [{"type": "x"}]})", "bodies[0].type: unknown body type 'x' (dynamic, kinematic, static)"},
+      {R"({"bodies": [{"shapes": [{"kind": "x"}]}]})",
+       "bodies[0].shapes[0].kind: unknown shape kind 'x' (sphere, box, capsule, cylinder)"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.json);
+    CHECK_THROWS_WITH(scenes::parse_scene_json(c.json, "x.json"), Catch::Matchers::Contains(c.says));
+  }
 }
 
 TEST_CASE("scene_to_json: a registry scene written and read back runs to the same state hash", "[options_json]") {

@@ -18,7 +18,7 @@ namespace {
 /// started at rest `tilt` rad off the vertical through A (a pendulum on A's surface).
 SceneDesc hanging_pair(double tilt, double rho_bodies) {
   SceneDesc s;
-  s.options.method = mag::Method::OursRealigned;
+  s.options.magnetics.method = mag::Method::OursRealigned;
   s.options.threads = 1;
   s.options.ground = false;
   s.options.rolling_friction_bodies = rho_bodies;

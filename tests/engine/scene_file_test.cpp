@@ -50,7 +50,7 @@ TEST_CASE("scene_file: the example loads and its balls rise to the magnet", "[sc
   CHECK(s.bodies[0].magnet);
   CHECK(s.bodies[0].moments[0].permanent);
   CHECK(s.bodies[1].shapes[0].size.x() == 0.005);
-  CHECK(s.options.method == mag::Method::OursRealigned);
+  CHECK(s.options.magnetics.method == mag::Method::OursRealigned);
   engine::SceneDesc s1 = s;
   s1.options.threads = 1;
   engine::Simulation sim(s1);
@@ -84,7 +84,6 @@ TEST_CASE("scene_file: every options key is read", "[scene_file]") {
     "camera": {"eye": [1, 1, 1], "target": [0, 0, 0.1], "up": [0, 0, 1], "fov_y_deg": 30},
     "bodies": []})", "x.json");
   const engine::SimOptions& o = s.options;
-  CHECK(o.method == mag::Method::Kim2018);
   CHECK(o.magnetics.method == mag::Method::Kim2018);
   CHECK(o.dt == 5e-4);
   CHECK(!o.ground);

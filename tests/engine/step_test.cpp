@@ -37,7 +37,7 @@ TEST_CASE("step: a sphere dropped on the plane comes to rest at its radius", "[s
 
 TEST_CASE("step: an iron ball released near a fixed magnet moves toward it", "[step]") {
   SceneDesc s = weightless();
-  s.options.method = mag::Method::OursRealigned;  // converges in weak fields (magnetics/PHYSICS.md)
+  s.options.magnetics.method = mag::Method::OursRealigned;  // converges in weak fields (magnetics/PHYSICS.md)
   s.bodies.push_back(cube_magnet(Vec3(0, 0, 0), Vec3(0, 0, 1.0)));
   s.bodies.push_back(iron_ball("ball", Vec3(0.001, 0, -0.03)));
   engine::Simulation sim(s);
@@ -112,7 +112,7 @@ TEST_CASE("step: every method runs and pulls a ball toward the magnet", "[step]"
                              mag::Method::DampingLLG, mag::Method::Exact}) {
     INFO(mag::method_name(method));
     SceneDesc s = weightless();
-    s.options.method = method;
+    s.options.magnetics.method = method;
     s.bodies.push_back(cube_magnet(Vec3(0, 0, 0), Vec3(0, 0, 1.0)));
     s.bodies.push_back(iron_ball("ball_0", Vec3(0.0, 0, -0.03)));
     s.bodies.push_back(iron_ball("ball_1", Vec3(0.012, 0, -0.03)));

@@ -51,7 +51,7 @@ inline SceneRun run_scene(const std::string& name, mag::Method method, double se
   p.count = count;
   p.strength = strength;
   engine::SceneDesc d = scenes::find_scene(name)->build(p);
-  d.options.method = method;
+  d.options.magnetics.method = method;
   d.options.threads = 1;
   if (dt_m > 0) d.options.magnetics.dt = dt_m;
   if (edit) edit(d);

@@ -77,8 +77,10 @@ TEST_CASE("magsolve rejects bad input with a one-line error and a non-zero exit"
     CHECK(r.out.find("nan") == std::string::npos);
   }
   CHECK(run("/nonexistent/case.json").code != 0);
-  CHECK(run(write_tmp("ok", "{\"moments\": [" + std::string(kBall) + "]}") + " --method nope")
-            .code != 0);
+  const Result nope = run(write_tmp("ok", "{\"moments\": [" + std::string(kBall) + "]}") + " --method nope");
+  CHECK(nope.code != 0);
+  CHECK(nope.out.find("unknown method 'nope' (ours, ours-realigned, kim2018, damping-llg, exact, anderson)") !=
+        std::string::npos);
   CHECK(run(write_tmp("ok2", "{\"moments\": [" + std::string(kBall) + "]}") + " --dt 1").code != 0);
   // the same point is fine with softening
   CHECK(run(write_tmp("soft", "{\"moments\": [" + b + "," + b + "]}") + " --softening 0.001")

@@ -94,12 +94,13 @@ TEST_CASE("magsim-scene refuses bad ODE flags with a message and exit code 1", "
     const char* says;
   };
   const Case cases[] = {
-      {"balls_up --steps 1 --no-render --space octree", "--space"},
+      {"balls_up --steps 1 --no-render --space octree", "--space: unknown broad phase 'octree' (hash, sap, simple)"},
       {"balls_up --steps 1 --no-render --quickstep-iterations 0", "--quickstep-iterations"},
       {"balls_up --steps 1 --no-render --quickstep-iterations many", "--quickstep-iterations"},
       {"balls_up --steps 1 --no-render --softening -0.001", "--softening"},
       {"balls_up --steps 1 --no-render --softening 1", "--softening"},
-      {"balls_up --steps 1 --no-render --force-model total", "--force-model"},
+      {"balls_up --steps 1 --no-render --force-model total",
+       "--force-model: unknown force model 'total' (method, zeeman, classic, zeeman-total)"},
       {"balls_up --steps 1 --no-render --substep-load maybe", "--substep-load"},
       {"balls_up --steps 1 --no-render --bounded-pairs yes", "--bounded-pairs"},
       {"balls_up --steps 1 --no-render --balance-magnetic-torque yes", "--balance-magnetic-torque"},

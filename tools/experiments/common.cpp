@@ -22,7 +22,7 @@ std::vector<mag::Method> parse_methods(const std::string& list) {
   std::string name;
   while (std::getline(ss, name, ',')) {
     mag::Method m;
-    if (!mag::parse_method(name, &m)) throw CLI::ValidationError("--methods", "unknown method " + name);
+    if (!mag::parse_method(name, &m)) throw CLI::ValidationError("--methods", mag::kMethodNames.unknown("method", name));
     v.push_back(m);
   }
   return v;

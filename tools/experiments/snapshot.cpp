@@ -69,7 +69,7 @@ Snapshot sakura_snapshot(const SnapshotOpts& o, const std::string& out) {
   magsim::scenes::SceneParams p;
   p.count = o.count;
   magsim::engine::SceneDesc d = magsim::scenes::find_scene("sakura_tree")->build(p);
-  d.options.method = mag::Method::OursRealigned;
+  d.options.magnetics.method = mag::Method::OursRealigned;
   d.options.dt = o.dt;
   d.options.threads = o.threads;
   use_threads(o.threads);

@@ -26,7 +26,7 @@ Outcome run_outcome(const std::string& scene, mag::Method method, double tol, do
   const auto* e = magsim::scenes::find_scene(scene);
   if (!e) throw CLI::ValidationError("--outcome-scene", "unknown scene " + scene);
   magsim::engine::SceneDesc d = e->build({});
-  d.options.method = method;
+  d.options.magnetics.method = method;
   d.options.magnetics.tol = tol;
   magsim::engine::Simulation sim(d);
   Outcome o;

@@ -156,8 +156,8 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     }
     s = e->build(p);
   }
-  if (app.count("--method") && !mag::parse_method(a.method, &s.options.method))
-    throw UsageError("unknown method '" + a.method + "'");
+  if (app.count("--method") && !mag::parse_method(a.method, &s.options.magnetics.method))
+    throw UsageError("--method: " + mag::kMethodNames.unknown("method", a.method));
   // the thread cap holds for the flag and the scene file alike (--write-scene too)
   const std::string cap = "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
                           std::to_string(tools::max_threads() / 4) + " cores), got ";
@@ -172,8 +172,8 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
   if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
   if (app.count("--auto-disable")) s.options.auto_disable = true;
-  if (app.count("--force-model") && !engine::parse_force_choice(a.force_model, &s.options.force_model))
-    throw UsageError("--force-model: unknown force model '" + a.force_model + "' (method, zeeman, classic or zeeman-total)");
+  if (app.count("--force-model") && !mag::kForceModelNames.parse(a.force_model, &s.options.force_model))
+    throw UsageError("--force-model: " + mag::kForceModelNames.unknown("force model", a.force_model));
   if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
   if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
   if (app.count("--substep-load")) s.options.substep_load = on_off("--substep-load", a.substep_load);
@@ -193,7 +193,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   if (app.count("--softening")) s.options.magnetics.field.softening = a.softening;
   if (app.count("--space")) {
     if (!engine::parse_space(a.space, &s.options.space))
-      throw UsageError("--space: unknown broad phase '" + a.space + "' (hash, sap or simple)");
+      throw UsageError("--space: " + engine::kSpaceNames.unknown("broad phase", a.space));
   }
   mag::FieldOptions& f = s.options.magnetics.field;
   try {
@@ -202,7 +202,6 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     throw UsageError(e.what());
   }
   if (const std::string e = mag::validate(f); !e.empty()) throw UsageError("field options: " + e);
-  s.options.magnetics.method = s.options.method;
   return s;
 }
 
@@ -248,11 +247,11 @@ int main(int argc, char** argv) {
   Args a;
   app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
   app.add_option("--method", a.method,
-                 scenes::method_list(" | ") +
+                 mag::kMethodNames.list(" | ") +
                      " (default: the scene's, anderson: M = f(H(M)) converged every sub-step, with the classic "
                      "force, -grad of the co-energy U*; ours = the paper as printed: theta dynamics eqs. 8-11 and "
                      "eq. 4, which has no energy; kim2018 = the baseline)")
-      ->check(CLI::IsMember(scenes::method_names()));
+      ->check(CLI::IsMember(mag::kMethodNames.names()));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(kFinitePositive);
   auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(tools::Range(1L, static_cast<long>(kMaxSteps)));
@@ -275,7 +274,7 @@ int main(int argc, char** argv) {
   app.add_option("--quickstep-iterations", a.quickstep_iterations,
                  "ODE QuickStep (contact solver) iterations per rigid step (default: the scene's, 20)")
       ->check(tools::OptionCheck("quickstep_iterations"));
-  app.add_option("--space", a.space, "ODE broad phase: sap | hash | simple (default: the scene's, sap)");
+  app.add_option("--space", a.space, "ODE broad phase: " + engine::kSpaceNames.list(" | ") + " (default: the scene's, sap)");
   app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
   app.add_option("--force-model", a.force_model,
                  "force on induced moments: method (the method's own: classic for anderson, exact and kim2018, "
@@ -330,7 +329,7 @@ int main(int argc, char** argv) {
                  "force, in [0, 0.1] (default: the scene's)")
       ->check(tools::OptionCheck("magnetics.softening"));
   a.field.add(&app,
-              "direct | barnes-hut | auto: how the dipole fields are summed, for the magnetization "
+              mag::kFieldSolverNames.list(" | ") + ": how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
               "--bh-threshold moments on");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");

@@ -144,7 +144,7 @@ int run(const Args& a, const CLI::App& app) {
   const unsigned cores = std::thread::hardware_concurrency();
   engine::ThreadGovernor governor(cores > 0 ? static_cast<int>(cores) : 1);  // Simulation caps it at its own count
   engine::SceneDesc scene = resolve_scene(a, app);
-  const std::string method = mag::method_name(scene.options.method);
+  const std::string method = mag::method_name(scene.options.magnetics.method);
   {
     // the memory the run will take, refused up front when it will not fit (magsim_scene.hpp);
     // the steps as below, bounded by kMaxSteps (a longer run is refused there)
@@ -289,7 +289,7 @@ int run(const Args& a, const CLI::App& app) {
       {"modelling_level", scene.modelling_level},
       {"method", method},
       // the force actually used, in --force-model's spelling ("zeeman" = eq. 4)
-      {"force_model", engine::force_model_name(engine::resolved_force_model(model.options))},
+      {"force_model", mag::kForceModelNames.name(engine::resolved_force_model(model.options))},
       // the run's options in the scene file's spelling (scenes/options_json.hpp): pasted into
       // a scene file as "options" they rerun this run
       {"options", scenes::to_json(model.options)},
