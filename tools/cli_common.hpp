@@ -112,6 +112,11 @@ inline std::string omp_num_threads_error() {
   return {};
 }
 
+/// The --help line of both programs on MAGSIM_KERNEL (checked by magsim_kernel_error below).
+inline constexpr const char* kMagsimKernelHelp =
+    "MAGSIM_KERNEL=portable: the portable field kernels even on a CPU with AVX-512 (unset or "
+    "auto: AVX-512 where the CPU has it; other values are refused).";
+
 /// "" when MAGSIM_KERNEL is unset, "auto" or "portable" (magnetics/field_kernel.hpp: the
 /// portable field kernels even on a CPU with AVX-512), else the one-line reason. The library
 /// takes any other value as "auto"; both programs refuse it, so that a typo cannot pass for

@@ -176,9 +176,8 @@ int run(int argc, char** argv) {
       "bad input or flags", "the solve failed", "the output could not be written",
       "The Newton reference needs three dense 3N x 3N matrices for N induced moments; above 2 GiB "
       "(N > 3153) magsolve refuses the case (exit 1). So it does a CASE that is not a regular file "
-      "or is larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n"
-      "MAGSIM_KERNEL=portable: the portable field kernels even on a CPU with AVX-512 (unset or "
-      "auto: AVX-512 where the CPU has it; other values are refused)."));
+      "or is larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
+      std::string(magsim::tools::kMagsimKernelHelp)));
   if (const int code = magsim::tools::parse_command_line(app, argc, argv, "magsolve: "); code >= 0) return code;
   if (const std::string e = magsim::tools::omp_num_threads_error(); !e.empty()) {
     std::fprintf(stderr, "magsolve: %s\n", e.c_str());

@@ -75,7 +75,6 @@ Snapshot sakura_snapshot(const SnapshotOpts& o, const std::string& out) {
   use_threads(o.threads);
   Snapshot sn;
   sn.dyn = d.options.magnetics;
-  sn.dyn.method = mag::Method::OursRealigned;
   // errors against the ground truth need exact fields: the default, Auto, would take
   // Barnes–Hut from 2000 moments on (--count up to 2500)
   sn.dyn.field.solver = mag::FieldSolver::Direct;

@@ -341,9 +341,8 @@ int main(int argc, char** argv) {
                                       "an output file could not be written",
                                       "Runs longer than 1e7 rigid steps are refused; so are runs whose estimated memory exceeds "
                                       "MemAvailable or what ulimit -v leaves, scene files that are not regular "
-                                      "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n"
-                                      "MAGSIM_KERNEL=portable: the portable field kernels even on a CPU with AVX-512 "
-                                      "(unset or auto: AVX-512 where the CPU has it; other values are refused).\n"
+                                      "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
+                                      std::string(tools::kMagsimKernelHelp) + "\n"
                                       "Every option flag has the range of its scene-file key (scenes/option_ranges.hpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
                                       "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
