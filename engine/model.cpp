@@ -102,6 +102,13 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
   const std::string e = mag::validate(o.magnetics);
   if (!e.empty()) fail("options.magnetics", e);
+  // the pair model is a correction of U*: only the classic force is its gradient
+  if (o.magnetics.field.near_field.model == mag::NearField::Pair &&
+      resolved_force_model(o) != mag::ForceModel::Classic)
+    fail("options.near_field", std::string("pair needs the classic force (the default's); method '") +
+                                   mag::method_name(o.magnetics.method) + "' with force '" +
+                                   mag::kForceModelNames.name(resolved_force_model(o)) +
+                                   "' has no energy for it to correct");
 }
 
 void check_shape(const std::string& where, int k, const ShapeDesc& s) {

@@ -55,6 +55,7 @@ std::string validate(const FieldOptions& o) {
   else if (o.bh_leaf_size < 1) e << "bh_leaf_size must be >= 1, got " << o.bh_leaf_size;
   else if (o.bh_group_size < 1) e << "bh_group_size must be >= 1, got " << o.bh_group_size;
   else if (o.bh_order < 1 || o.bh_order > 2) e << "bh_order must be 1 or 2, got " << o.bh_order;
+  else return validate(o.near_field);
   return e.str();
 }
 
@@ -73,7 +74,7 @@ FieldSolver resolve_solver(const FieldOptions& opt, std::size_t n) {
 
 // scratch: a copy starts with the packed arrays but builds its own tree
 FieldWorkspace::FieldWorkspace(const FieldWorkspace& o)
-    : src(o.src), bounded(o.bounded) {}
+    : src(o.src), bounded(o.bounded), near(o.near) {}
 FieldWorkspace& FieldWorkspace::operator=(const FieldWorkspace& o) {
   if (this != &o) {
     FieldWorkspace t(o);
@@ -180,10 +181,13 @@ void compute_fields(const MomentDesc& set, const Magnetization& mz, const FieldO
   if (resolve_solver(opt, set.size()) == FieldSolver::BarnesHut) {
     if (!ws->bh) ws->bh.reset(new_barnes_hut_workspace());
     barnes_hut_fields(set, mz, opt, H, J, ws->bh.get());
-    return;
+  } else {
+    pack_sources(set, mz, opt, ws);
+    direct_sum(set, opt, *ws, nullptr, n, H->data(), J ? J->data() : nullptr);
   }
-  pack_sources(set, mz, opt, ws);
-  direct_sum(set, opt, *ws, nullptr, n, H->data(), J ? J->data() : nullptr);
+  // the pair model's field on touching spheres (near_field.hpp; J stays the dipoles': the
+  // model's forces are added by compute_forces)
+  add_near_field(set, mz, opt.near_field, &ws->near, H);
 }
 
 void compute_fields_at(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,

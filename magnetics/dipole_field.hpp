@@ -2,6 +2,7 @@
 #pragma once
 
 #include "magnetics/moments.hpp"
+#include "magnetics/near_field.hpp"
 
 #include <memory>
 #include <string>
@@ -62,6 +63,9 @@ struct FieldOptions {
   /// double): adds < 1e-5 to the relative RMS of H and J (barnes_hut.hpp).
   /// false: far cells in double (the near field as bh_near_float says).
   bool bh_far_float = true;
+  /// The near-field model of touching induced spheres (near_field.hpp): dipole (none) or
+  /// pair. compute_fields adds its field; compute_forces its forces (classic force only).
+  NearFieldOptions near_field;
 };
 
 /// A solver's name in kFieldSolverNames.
@@ -115,6 +119,8 @@ struct FieldWorkspace {
   bool bounded = false;  ///< the packed sources are summed as bounded pairs
   /// Barnes–Hut tree and per-thread scratch, created on first use.
   std::unique_ptr<BarnesHutWorkspace, BarnesHutWorkspaceDeleter> bh;
+  /// The near-field pair list and coupling table (NearField::Pair).
+  NearFieldWorkspace near;
 };
 
 /// Field of one dipole m at offset r = p − p_i (eq. 1, softened when eps2 > 0):

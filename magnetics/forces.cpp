@@ -146,6 +146,9 @@ void compute_forces(const MomentDesc& set, const Magnetization& mz, ForceModel m
   if (model == ForceModel::Classic && pairs_bounded(set, field))
     bounded_pair_forces(set, mz, field, ws, F);
   if (model == ForceModel::Classic && tau) same_body_torques(set, mz, field, ws, tau);
+  // the pair model's forces: −∇ of its pair energy, as the classic force is of U*'s pair sum
+  if (model == ForceModel::Classic)
+    add_near_field_forces(set, mz, field.near_field, &ws->field.near, F, tau);
   if (!(reaction_symmetric && model == ForceModel::Zeeman)) return;
   // the effective moments m̃_j = V_j [A_j(2M_j + H_j) + M_j] as sources (scratch set reused)
   MomentSet& eff = ws->effective;

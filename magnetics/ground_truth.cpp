@@ -7,6 +7,7 @@
 #include "magnetics/ground_truth.hpp"
 
 #include "magnetics/curves.hpp"
+#include "magnetics/near_field.hpp"
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -53,6 +54,18 @@ Problem build(const MomentDesc& set, const FieldOptions& field) {
       const double inv5 = inv3 * inv * inv;
       const Mat3 G = inv4pi * (3.0 * inv5 * (r * r.transpose()) - inv3 * Mat3::Identity());
       P.T.block<3, 3>(3 * a, 3 * b) = G * set.volume[i];
+    }
+  }
+  // the near-field pair model's couplings (near_field.hpp), affine in M as the dipoles are
+  std::vector<NearCoupling> near;
+  NearFieldWorkspace nws;
+  near_field_couplings(set, field.near_field, &nws, &near);
+  if (!near.empty()) {
+    std::vector<int> slot(set.size(), -1);
+    for (int a = 0; a < k; ++a) slot[P.idx[a]] = a;
+    for (const NearCoupling& c : near) {
+      P.T.block<3, 3>(3 * slot[c.i], 3 * slot[c.j]) += c.K * set.volume[c.j];
+      P.T.block<3, 3>(3 * slot[c.j], 3 * slot[c.i]) += c.K * set.volume[c.i];
     }
   }
   return P;

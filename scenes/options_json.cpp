@@ -74,6 +74,8 @@ json to_json(const SimOptions& o) {
               {"bh_order", f.bh_order},
               {"bh_near_float", f.bh_near_float},
               {"bh_far_float", f.bh_far_float},
+              {"near_field", mag::kNearFieldNames.name(f.near_field.model)},
+              {"near_field_mu_r", f.near_field.mu_r},
               {"magnetics", to_json(o.magnetics)}};
 }
 
@@ -113,7 +115,7 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
                    "bh_theta", "bh_threshold", "magnetics", "force_model", "max_substeps", "substep_reach",
                    "substep_load", "rolling_friction", "rolling_friction_bodies", "eddy_conductivity",
                    "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
-                   "bh_near_float", "bh_far_float", "energy_guard", "energy_guard_tolerance",
+                   "bh_near_float", "bh_far_float", "near_field", "near_field_mu_r", "energy_guard", "energy_guard_tolerance",
                    "energy_guard_floor", "energy_guard_max_substeps"});
   if_present(j, "method", path, [&](const json& v, const std::string& p) { o->magnetics.method = r.named(v, p, mag::kMethodNames, "method"); });
   if_present(j, "dt", path, [&](const json& v, const std::string& p) {
@@ -168,6 +170,10 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, SimO
   if_present(j, "bh_order", path, [&](const json& v, const std::string& p) { f.bh_order = r.integer(v, p, 1, 2); });
   if_present(j, "bh_near_float", path, [&](const json& v, const std::string& p) { f.bh_near_float = r.boolean(v, p); });
   if_present(j, "bh_far_float", path, [&](const json& v, const std::string& p) { f.bh_far_float = r.boolean(v, p); });
+  if_present(j, "near_field", path, [&](const json& v, const std::string& p) {
+    f.near_field.model = r.named(v, p, mag::kNearFieldNames, "near-field model");
+  });
+  if_present(j, "near_field_mu_r", path, [&](const json& v, const std::string& p) { f.near_field.mu_r = r.in_range(v, p, 10.0, 10000.0); });
   if_present(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
   if_present(j, "magnetics", path, [&](const json& v, const std::string& p) { from_json(r, v, p, &o->magnetics); });
 }

@@ -1,6 +1,7 @@
 // tools/field_flags.hpp — the dipole-field flags shared by magsim-scene and bench:
-// --field-solver (mag::kFieldSolverNames), --bh-theta θ, --bh-threshold N. Flags not given
-// leave the scene's FieldOptions as they are.
+// --field-solver (mag::kFieldSolverNames), --bh-theta θ, --bh-threshold N, --near-field
+// (mag::kNearFieldNames), --near-field-mu-r μr. Flags not given leave the scene's FieldOptions
+// as they are.
 #pragma once
 
 #include "magnetics/dipole_field.hpp"
@@ -21,6 +22,10 @@ struct FieldFlags {
   CLI::Option* solver_opt = nullptr;
   CLI::Option* theta_opt = nullptr;
   CLI::Option* threshold_opt = nullptr;
+  std::string near_field;
+  double mu_r = mag::NearFieldOptions{}.mu_r;
+  CLI::Option* near_opt = nullptr;
+  CLI::Option* mu_r_opt = nullptr;
 
   void add(CLI::App* app, const std::string& solver_help) {
     solver_opt = app->add_option("--field-solver", solver, solver_help);
@@ -30,6 +35,14 @@ struct FieldFlags {
     threshold_opt = app->add_option("--bh-threshold", threshold, "auto: moments from which Barnes-Hut is used")
                         ->check(OptionCheck("bh_threshold"))
                         ->capture_default_str();
+    near_opt = app->add_option("--near-field", near_field,
+                               "near field of touching iron balls: " + mag::kNearFieldNames.list("|") +
+                                   " (pair: exact two-sphere couplings, faded as the contact saturates; "
+                                   "classic force only). Default: the scene's (registry scenes: dipole)");
+    mu_r_opt = app->add_option("--near-field-mu-r", mu_r,
+                               "initial relative permeability of the iron, read by --near-field pair, "
+                               "in [10, 10000]")
+                   ->capture_default_str();
   }
   bool has_solver() const { return solver_opt && solver_opt->count() > 0; }
 
@@ -49,6 +62,15 @@ struct FieldFlags {
       std::snprintf(got, sizeof got, "%g", theta);
       throw std::invalid_argument(std::string("--bh-theta: the Barnes-Hut opening angle must be in (0, 1], got ") + got);
     }
+    mag::NearField m;
+    if (near_opt && near_opt->count() && !mag::kNearFieldNames.parse(near_field, &m))
+      throw std::invalid_argument(mag::kNearFieldNames.unknown("--near-field", near_field));
+    if (mu_r_opt && mu_r_opt->count()) {
+      mag::NearFieldOptions o;
+      o.mu_r = mu_r;
+      if (const std::string e = mag::validate(o); !e.empty())
+        throw std::invalid_argument("--near-field-mu-r: " + e);
+    }
   }
 
   /// Applies the flags given on the command line to f (after check()).
@@ -57,6 +79,8 @@ struct FieldFlags {
     if (has_solver()) f->solver = parse(solver, "--field-solver");
     if (theta_opt && theta_opt->count()) f->bh_theta = theta;
     if (threshold_opt && threshold_opt->count()) f->auto_threshold = threshold;
+    if (near_opt && near_opt->count()) mag::kNearFieldNames.parse(near_field, &f->near_field.model);
+    if (mu_r_opt && mu_r_opt->count()) f->near_field.mu_r = mu_r;
   }
 };
 

@@ -44,6 +44,8 @@ if [ -x $bin/bench_kernel ]; then
   echo "== kernel throughput"
   $bin/bench_kernel --json "$out/kernel.json" | tee "$out/kernel.txt"
 fi
+echo "== two balls: dipole and pair model against exact magnetostatics"
+/usr/bin/python3 tools/reference/near_field_chart.py --out "$out" --magsolve $bin/magsolve | tee "$out/near_field.txt"
 /usr/bin/python3 tools/charts.py "$out"
 /usr/bin/python3 tools/report_index.py "$out"
 echo "report: $out/index.md ($(( $(date +%s) - t0 )) s)"

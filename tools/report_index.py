@@ -271,6 +271,15 @@ def main():
                  "force is 8× the classic one in the linear regime (the 2M term with ∂M/∂H = 3I) "
                  "and tends to it at saturation, so this claim does not reproduce.\n")
 
+    L.append("## Physical accuracy: two touching balls against exact magnetostatics (beyond the paper)\n")
+    L.append(img(out, "near_field.png", "near field"))
+    nf = os.path.join(out, "near_field.txt")
+    if os.path.exists(nf):
+        L.append("```\n" + open(nf).read().strip() + "\n```\n")
+    L.append("One dipole per ball against the exact linear two-sphere force (weak field) and the "
+             "finite-element force (g = 0.003a, H0/Ms = 1e-4…10), for `--near-field dipole` and "
+             "`pair` (tools/findings/near_field.md).\n")
+
     L.append("## Speed against accuracy (beyond the paper)\n")
     L.append(img(out, "speed_accuracy.png", "speed against accuracy"))
     L.append(img(out, "dt_iterations.png", "dt against iterations"))

@@ -48,6 +48,8 @@ SimOptions all_changed() {
   f.bh_order = 1;
   f.bh_near_float = false;
   f.bh_far_float = false;
+  f.near_field.model = mag::NearField::Pair;
+  f.near_field.mu_r = 300.0;
   o.reaction_symmetric_forces = true;
   o.balance_magnetic_torque = true;
   o.force_model = mag::ForceModel::Classic;
@@ -112,6 +114,8 @@ void check_equal(const SimOptions& a, const SimOptions& b) {
   CHECK(fa.bh_order == fb.bh_order);
   CHECK(fa.bh_near_float == fb.bh_near_float);
   CHECK(fa.bh_far_float == fb.bh_far_float);
+  CHECK(fa.near_field.model == fb.near_field.model);
+  CHECK(fa.near_field.mu_r == fb.near_field.mu_r);
   CHECK(a.reaction_symmetric_forces == b.reaction_symmetric_forces);
   CHECK(a.balance_magnetic_torque == b.balance_magnetic_torque);
   CHECK(a.force_model == b.force_model);
@@ -156,9 +160,9 @@ SimOptions read_back(const nlohmann::json& j) {
 
 // A new field in one of the three structs changes its size: add it to to_json, from_json,
 // all_changed and check_equal above (and SCENE_FILE.md), then update the size here.
-static_assert(sizeof(mag::FieldOptions) == 48, "FieldOptions changed: extend scenes/options_json.cpp");
-static_assert(sizeof(mag::DynamicsOptions) == 152, "DynamicsOptions changed: extend scenes/options_json.cpp");
-static_assert(sizeof(SimOptions) == 392, "SimOptions changed: extend scenes/options_json.cpp");
+static_assert(sizeof(mag::FieldOptions) == 64, "FieldOptions changed: extend scenes/options_json.cpp");
+static_assert(sizeof(mag::DynamicsOptions) == 168, "DynamicsOptions changed: extend scenes/options_json.cpp");
+static_assert(sizeof(SimOptions) == 408, "SimOptions changed: extend scenes/options_json.cpp");
 
 TEST_CASE("options_json: every field, away from its default, survives to_json and from_json", "[options_json]") {
   const SimOptions o = all_changed();

@@ -7,6 +7,7 @@
 #include "magnetics/curves.hpp"
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
+#include "magnetics/near_field.hpp"
 #include "tests/magnetics/fixtures.hpp"
 
 #include <catch2/catch.hpp>
@@ -69,7 +70,8 @@ void rotate_group(MomentSet* s, int g, const Vec3& c, const Vec3& e, double t) {
 struct Check {
   double worst_force = 0, worst_torque = 0;  // relative errors
 };
-Check check_gradient(const MomentSet& s0, Curve c, const FieldOptions& f, ForceModel model) {
+Check check_gradient(const MomentSet& s0, Curve c, const FieldOptions& f, ForceModel model,
+                     double h = 1e-7) {
   MomentSet s = s0;
   std::vector<Vec3> F, tau;
   forces_solved(&s, c, f, model, &F, &tau);
@@ -94,7 +96,7 @@ Check check_gradient(const MomentSet& s0, Curve c, const FieldOptions& f, ForceM
         break;
       }
   }
-  const double h = 1e-7, ht = 1e-5;  // m, rad
+  const double ht = 1e-5;  // rad; h in m
   Check r;
   std::vector<Vec3> Fb(bodies.size()), Tb(bodies.size());
   for (std::size_t b = 0; b < bodies.size(); ++b) {
@@ -225,6 +227,40 @@ TEST_CASE("classic force is -grad U* with softening and with bounded pairs", "[c
     REQUIRE(inside >= 2);
     const Check r = check_gradient(s, Curve::Tanh, f, ForceModel::Classic);
     INFO(inside << " pairs inside; force " << r.worst_force << " torque " << r.worst_torque);
+    CHECK(r.worst_force < 1e-6);
+    CHECK(r.worst_torque < 1e-6);
+  }
+}
+
+TEST_CASE("classic force with the near-field pair model is -grad U*", "[coenergy][near_field]") {
+  // pairs at gaps of 0.003a, 0.05a, 0.4a and 1.4a (the cut-off step), in the fade's range
+  // (weak magnet) and saturated (strong): the forces on balls and magnet, the magnet's torque
+  for (double strength : {0.3, 30.0}) {
+    FieldOptions f;
+    f.near_field.model = NearField::Pair;
+    MomentSet s = random_set(10, 5, strength, 2.5);
+    const double a = kBallRadius;
+    s.position[1] = s.position[0] + 2.003 * a * Vec3(0.6, -0.48, 0.64);
+    s.position[3] = s.position[2] + 2.05 * a * Vec3(0, 0.8, -0.6);
+    s.position[5] = s.position[4] + 2.4 * a * Vec3(0.36, 0.48, 0.8);
+    s.position[7] = s.position[6] + 3.4 * a * Vec3(1, 0, 0);
+    NearFieldWorkspace nws;
+    find_near_pairs(s, &nws);
+    REQUIRE(nws.pairs.size() >= 4);
+    // steps of 20 nm: the closest pair's force changes on the scale of its 15 µm gap
+    const Check r = check_gradient(s, Curve::Tanh, f, ForceModel::Classic, 2e-8);
+    INFO("strength " << strength << ": " << nws.pairs.size() << " near pairs; force " << r.worst_force
+                     << " torque " << r.worst_torque);
+    CHECK(r.worst_force < 1e-6);
+    CHECK(r.worst_torque < 1e-6);
+  }
+  SECTION("eq. 7's curve") {
+    FieldOptions f;
+    f.near_field.model = NearField::Pair;
+    MomentSet s = random_set(8, 3, 10.0, 2.5);
+    s.position[1] = s.position[0] + 2.01 * kBallRadius * Vec3(0, 0, 1);
+    const Check r = check_gradient(s, Curve::Kim, f, ForceModel::Classic, 2e-8);
+    INFO("force " << r.worst_force << " torque " << r.worst_torque);
     CHECK(r.worst_force < 1e-6);
     CHECK(r.worst_torque < 1e-6);
   }

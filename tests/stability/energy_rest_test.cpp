@@ -112,6 +112,21 @@ TEST_CASE("at 3x strength E never rises by more than the energy guard's toleranc
   CHECK(off.max_rise > 0.0);
 }
 
+TEST_CASE("the near-field pair model keeps the energy audit closed", "[stability][energy][near_field]") {
+  // balls_up with 54 balls, 0.4 s, with the pair model: its forces are −∇ of its term of U*,
+  // so E = K + U_g + U* (the term included) never rises beyond the guard's tolerance
+  const auto pair = [](engine::SceneDesc& d) { d.options.magnetics.field.near_field.model = mag::NearField::Pair; };
+  const auto r = run_heap("balls_up", 54, 1.0, 0.4, 0.1, pair);
+  INFO("largest rise beyond the tolerance " << r.max_rise << " J, E above its running minimum "
+                                            << r.rise_above_min << " J of " << r.energy_lost << " J lost, retakes "
+                                            << r.retakes << ", unresolved " << r.unresolved
+                                            << (r.failed ? ", failed: " + r.error : std::string()));
+  REQUIRE_FALSE(r.failed);
+  CHECK(r.unresolved == 0);
+  CHECK(r.max_rise <= 0.0);
+  CHECK(r.rise_above_min <= 0.01 * r.energy_lost);
+}
+
 TEST_CASE("sakura_tree at 3x on the robustness matrix's corner: the scene's load sub-steps keep it whole",
           "[stability][energy][sakura_tree]") {
   // 500 balls, 3x, QuickStep W 1.0 with 20 iterations, Δt_r 2 ms, 0.8 s: balls held at a tip

@@ -1,0 +1,329 @@
+// magnetics/near_field.cpp — the near-field pair model (near_field.hpp): the coupling table,
+// the fade, the pair list, and the model's field, energy and forces.
+#include "magnetics/near_field.hpp"
+
+#include "magnetics/dipole_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+namespace magsim::mag {
+
+namespace {
+#include "magnetics/near_field_table.inc"
+
+constexpr double kMuMin = 10.0, kMuMax = 10000.0;
+
+// Natural cubic spline second derivatives of y on a uniform grid (step h).
+std::vector<double> spline_second(const std::vector<double>& y, double h) {
+  const int n = static_cast<int>(y.size());
+  std::vector<double> m(n, 0.0), c(n, 0.0), d(n, 0.0);
+  // tridiagonal: m_{k-1} + 4 m_k + m_{k+1} = 6 (y_{k+1} − 2 y_k + y_{k−1}) / h², m_0 = m_{n−1} = 0
+  for (int k = 1; k < n - 1; ++k) {
+    const double rhs = 6.0 * (y[k + 1] - 2.0 * y[k] + y[k - 1]) / (h * h);
+    const double denom = 4.0 - (k > 1 ? c[k - 1] : 0.0);
+    c[k] = 1.0 / denom;
+    d[k] = (rhs - (k > 1 ? d[k - 1] : 0.0)) / denom;
+  }
+  for (int k = n - 2; k >= 1; --k) m[k] = d[k] - c[k] * m[k + 1];
+  return m;
+}
+
+double table_step() {
+  return (std::log(kTableGapMax) - std::log(kTableGapMin)) / (kTableNodes - 1);
+}
+
+// Value and derivative in x of the spline (y, m) at x = ln g_e.
+void spline_eval(const std::vector<double>& y, const std::vector<double>& m, double x,
+                 double* v, double* dv) {
+  const double h = table_step();
+  const double x0 = std::log(kTableGapMin);
+  double s = (x - x0) / h;
+  int k = static_cast<int>(std::floor(s));
+  k = std::clamp(k, 0, kTableNodes - 2);
+  const double t = s - k, u = 1.0 - t;
+  *v = u * y[k] + t * y[k + 1] + h * h / 6.0 * ((u * u * u - u) * m[k] + (t * t * t - t) * m[k + 1]);
+  *dv = (y[k + 1] - y[k]) / h + h / 6.0 * (-(3.0 * u * u - 1.0) * m[k] + (3.0 * t * t - 1.0) * m[k + 1]);
+}
+
+}  // namespace
+
+std::string validate(const NearFieldOptions& o) {
+  std::ostringstream e;
+  if (!(o.mu_r >= kMuMin && o.mu_r <= kMuMax))
+    e << "near-field mu_r must be in [" << kMuMin << ", " << kMuMax << "] (the table's span), got "
+      << o.mu_r;
+  return e.str();
+}
+
+// g_e = g_m + g_s ln(1 + e^x), x = (g − g_m)/g_s (a softplus, finite for any x)
+double pair_effective_gap(double g, double* dge_dg) {
+  const double x = (g - kPairContactGap) / kPairSmoothGap;
+  const double sp = x > 0 ? x + std::log1p(std::exp(-x)) : std::log1p(std::exp(x));
+  if (dge_dg) *dge_dg = x > 0 ? 1.0 / (1.0 + std::exp(-x)) : std::exp(x) / (1.0 + std::exp(x));
+  return kPairContactGap + kPairSmoothGap * sp;
+}
+
+PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
+  // row r and weight w of μr between the tabulated ones, linear in ln μr
+  int r = 0;
+  while (r < kTableMuCount - 2 && mu_r > kTableMu[r + 1]) ++r;
+  const double w = std::clamp(
+      (std::log(mu_r) - std::log(kTableMu[r])) / (std::log(kTableMu[r + 1]) - std::log(kTableMu[r])),
+      0.0, 1.0);
+  par_.resize(kTableNodes);
+  perp_.resize(kTableNodes);
+  for (int k = 0; k < kTableNodes; ++k) {
+    par_[k] = (1.0 - w) * kTableAxial[r][k] + w * kTableAxial[r + 1][k];
+    perp_[k] = (1.0 - w) * kTableTransverse[r][k] + w * kTableTransverse[r + 1][k];
+  }
+  par2_ = spline_second(par_, table_step());
+  perp2_ = spline_second(perp_, table_step());
+}
+
+// Δt(g) = spline(ln g_e(g)); dΔt/dg = spline'(x) · (1/g_e) · dg_e/dg
+PairCoupling PairCouplingTable::at(double g) const {
+  double dge = 0;
+  const double ge = pair_effective_gap(g, &dge);
+  const double x = std::log(ge), dx = dge / ge;
+  PairCoupling c;
+  double d = 0;
+  spline_eval(par_, par2_, x, &c.par, &d);
+  c.dpar = d * dx;
+  spline_eval(perp_, perp2_, x, &c.perp, &d);
+  c.dperp = d * dx;
+  return c;
+}
+
+// S(g) = 1 − (10 s³ − 15 s⁴ + 6 s⁵), s = (g − g_full)/(g_cut − g_full) ∈ [0, 1]
+double pair_switch(double g, double* dS_dg) {
+  const double w = kPairCutoffGap - kPairFullGap;
+  const double s = (g - kPairFullGap) / w;
+  if (s <= 0) {
+    if (dS_dg) *dS_dg = 0;
+    return 1.0;
+  }
+  if (s >= 1) {
+    if (dS_dg) *dS_dg = 0;
+    return 0.0;
+  }
+  if (dS_dg) *dS_dg = -30.0 * s * s * (1.0 - s) * (1.0 - s) / w;
+  return 1.0 - s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+}
+
+// φ = 1/(1 + z), z = (h/h0)^p, h0 = h0* at every gap: c Δt must fall with the gap for the
+// correction to attract, and a fade that sets in later at wider gaps (h0 growing faster than
+// g^0.15 near contact) makes it repel — against the finite-element data's sign
+PairFade pair_fade(double h, double g) {
+  (void)g;
+  PairFade f;
+  if (h <= 0) return f;
+  const double z = std::pow(h / kPairFadeField, kPairFadePower);
+  f.phi = 1.0 / (1.0 + z);
+  f.dphi_dh = -f.phi * f.phi * kPairFadePower * z / h;
+  return f;
+}
+
+const PairCouplingTable& NearFieldWorkspace::table_for(double mu_r) {
+  if (table.empty() || table[0].mu_r() != mu_r) {
+    table.clear();
+    table.emplace_back(mu_r);
+  }
+  return table[0];
+}
+
+void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
+  const std::size_t n = set.size();
+  ws->pairs.clear();
+  ws->a.assign(n, 0.0);
+  ws->perm.clear();
+  for (std::size_t j = 0; j < n; ++j)
+    if (set.kind[j] == MomentKind::Permanent) ws->perm.push_back(static_cast<int>(j));
+  // moments per group: a sphere is the only moment of its body
+  std::unordered_map<std::int32_t, int> count;
+  for (std::size_t j = 0; j < n; ++j)
+    if (set.group[j] >= 0) ++count[set.group[j]];
+  double amax = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (set.kind[j] != MomentKind::Induced || !(set.volume[j] > 0)) continue;
+    if (set.group[j] >= 0 && count[set.group[j]] != 1) continue;
+    const double a = std::cbrt(3.0 * set.volume[j] / (4.0 * kPi));
+    const double rad = j < set.radius.size() ? set.radius[j] : 0.0;
+    if (rad > 0 && std::abs(rad - a) > 1e-6 * a) continue;
+    ws->a[j] = a;
+    amax = std::max(amax, a);
+  }
+  if (amax == 0) return;
+  // uniform grid of cells one cut-off distance wide; neighbours are in the 27 cells around
+  const double cell = (2.0 + kPairCutoffGap) * amax;
+  auto key = [](long long x, long long y, long long z) {
+    return ((x & 0x1FFFFF) << 42) | ((y & 0x1FFFFF) << 21) | (z & 0x1FFFFF);
+  };
+  ws->cells.clear();
+  std::vector<long long> cx(n), cy(n), cz(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    if (ws->a[j] == 0) continue;
+    cx[j] = static_cast<long long>(std::floor(set.position[j].x() / cell));
+    cy[j] = static_cast<long long>(std::floor(set.position[j].y() / cell));
+    cz[j] = static_cast<long long>(std::floor(set.position[j].z() / cell));
+    ws->cells.emplace_back(key(cx[j], cy[j], cz[j]), static_cast<int>(j));
+  }
+  std::sort(ws->cells.begin(), ws->cells.end());
+  for (std::size_t j = 0; j < n; ++j) {
+    if (ws->a[j] == 0) continue;
+    const double aj = ws->a[j];
+    for (long long dx = -1; dx <= 1; ++dx)
+      for (long long dy = -1; dy <= 1; ++dy)
+        for (long long dz = -1; dz <= 1; ++dz) {
+          const long long k = key(cx[j] + dx, cy[j] + dy, cz[j] + dz);
+          auto it = std::lower_bound(ws->cells.begin(), ws->cells.end(), std::make_pair(k, -1));
+          for (; it != ws->cells.end() && it->first == k; ++it) {
+            const int i = it->second;
+            if (i <= static_cast<int>(j)) continue;
+            if (std::abs(ws->a[i] - aj) > 1e-9 * aj) continue;  // identical spheres only
+            const double d = (set.position[i] - set.position[j]).norm();
+            if (d < (2.0 + kPairCutoffGap) * aj) ws->pairs.push_back({static_cast<int>(j), i});
+          }
+        }
+  }
+  std::sort(ws->pairs.begin(), ws->pairs.end(),
+            [](const NearPair& p, const NearPair& q) { return p.i != q.i ? p.i < q.i : p.j < q.j; });
+}
+
+namespace {
+// Everything one pair's energy, field and forces need.
+struct PairGeometry {
+  Vec3 rhat;
+  double rho = 0, a = 0, g = 0;
+  double A = 0, B = 0, dA = 0, dB = 0;  // Δt∥/a³, Δt⊥/a³ and d/dρ
+  double S = 0, dS = 0;                  // switch and dS/dρ
+  PairFade fade;                         // φ, ∂φ/∂h, ∂φ/∂g
+  Vec3 Hhat = Vec3::Zero();              // direction of H_app
+  double Ms = 0;
+  Mat3 Japp = Mat3::Zero();              // ∂H_app/∂x at the midpoint
+  Vec3 mid = Vec3::Zero();
+};
+
+PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
+                      const NearFieldWorkspace& ws, const NearPair& p, bool with_jacobian) {
+  PairGeometry q;
+  const Vec3 r = set.position[p.i] - set.position[p.j];
+  q.rho = r.norm();
+  q.a = ws.a[p.i];
+  q.rhat = r / q.rho;
+  q.g = q.rho / q.a - 2.0;
+  double dS_dg = 0;
+  q.S = pair_switch(q.g, &dS_dg);
+  q.dS = dS_dg / q.a;
+  const PairCoupling c = tab.at(q.g);
+  const double a3 = q.a * q.a * q.a;
+  q.A = c.par / a3;
+  q.B = c.perp / a3;
+  q.dA = c.dpar / (a3 * q.a);
+  q.dB = c.dperp / (a3 * q.a);
+  // H_app: the permanent moments' field and H0 at the midpoint
+  q.mid = 0.5 * (set.position[p.i] + set.position[p.j]);
+  Vec3 H = set.H0;
+  for (const int k : ws.perm) {
+    const Vec3& m = set.m_perm[k];
+    H += dipole_field(q.mid - set.position[k], m);
+    if (with_jacobian) q.Japp += dipole_jacobian(q.mid - set.position[k], m);
+  }
+  q.Ms = 0.5 * (set.Ms[p.i] + set.Ms[p.j]);
+  const double Hn = H.norm();
+  if (Hn > 0) q.Hhat = H / Hn;
+  q.fade = pair_fade(q.Ms > 0 ? Hn / q.Ms : 0.0, q.g);
+  return q;
+}
+
+// ΔT v = (A − B) r̂ (r̂·v) + B v
+Vec3 apply_coupling(const PairGeometry& q, const Vec3& v) {
+  return (q.A - q.B) * q.rhat.dot(v) * q.rhat + q.B * v;
+}
+}  // namespace
+
+void near_field_couplings(const MomentDesc& set, const NearFieldOptions& opt,
+                          NearFieldWorkspace* ws, std::vector<NearCoupling>* out) {
+  out->clear();
+  if (opt.model != NearField::Pair) return;
+  find_near_pairs(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  for (const NearPair& p : ws->pairs) {
+    const PairGeometry q = geometry(set, tab, *ws, p, false);
+    const double c = q.S * q.fade.phi;
+    const Mat3 K = c * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
+    out->push_back({p.i, p.j, K});
+  }
+}
+
+void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
+                    NearFieldWorkspace* ws, std::vector<Vec3>* H) {
+  if (opt.model != NearField::Pair) return;
+  find_near_pairs(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  for (const NearPair& p : ws->pairs) {
+    const PairGeometry q = geometry(set, tab, *ws, p, false);
+    const double c = q.S * q.fade.phi;
+    if (c == 0) continue;
+    (*H)[p.i] += c * apply_coupling(q, moment(set, mz, p.j));
+    (*H)[p.j] += c * apply_coupling(q, moment(set, mz, p.i));
+  }
+}
+
+// E_ij = −μ0 c W,  W = (A − B)(m_i·r̂)(m_j·r̂) + B m_i·m_j
+double near_field_energy(const MomentDesc& set, const Magnetization& mz,
+                         const NearFieldOptions& opt, NearFieldWorkspace* ws) {
+  if (opt.model != NearField::Pair) return 0.0;
+  find_near_pairs(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  double E = 0;
+  for (const NearPair& p : ws->pairs) {
+    const PairGeometry q = geometry(set, tab, *ws, p, false);
+    const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
+    E -= kMu0 * q.S * q.fade.phi * mi.dot(apply_coupling(q, mj));
+  }
+  return E;
+}
+
+// With r = p_i − p_j, ρ = |r|, c = S(g) φ(h, g), h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
+//   ∂W/∂r = [(A' − B') P + B' Q] r̂ + (A − B) ∇_r P,
+//   ∇_r P = [(m_j·r̂)(m_i − (m_i·r̂) r̂) + (m_i·r̂)(m_j − (m_j·r̂) r̂)]/ρ,
+//   ∂c/∂ρ = S' φ + S ∂φ/∂g / a,   ∇_x c = S (∂φ/∂h) J_app Ĥ / Ms   (J_app symmetric),
+//   F_i = μ0 [c ∂W/∂r + W (∂c/∂ρ r̂ + ½ ∇_x c)],  F_j = μ0 [−c ∂W/∂r − W ∂c/∂ρ r̂ + ½ W ∇_x c],
+//   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 W S (∂φ/∂h)/Ms J_k Ĥ,
+//                                           τ_k = μ0 W S (∂φ/∂h)/Ms m_k × h(x − p_k, Ĥ).
+void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
+                           const NearFieldOptions& opt, NearFieldWorkspace* ws,
+                           std::vector<Vec3>* F, std::vector<Vec3>* tau) {
+  if (opt.model != NearField::Pair) return;
+  find_near_pairs(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  for (const NearPair& p : ws->pairs) {
+    const PairGeometry q = geometry(set, tab, *ws, p, true);
+    const double c = q.S * q.fade.phi;
+    const double dc = q.dS * q.fade.phi + q.S * q.fade.dphi_dg / q.a;
+    if (c == 0 && dc == 0) continue;
+    const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
+    const double ui = mi.dot(q.rhat), uj = mj.dot(q.rhat);
+    const double P = ui * uj, Q = mi.dot(mj);
+    const double W = (q.A - q.B) * P + q.B * Q;
+    const Vec3 dP = (uj * (mi - ui * q.rhat) + ui * (mj - uj * q.rhat)) / q.rho;
+    const Vec3 dW = ((q.dA - q.dB) * P + q.dB * Q) * q.rhat + (q.A - q.B) * dP;
+    const double kh = q.Ms > 0 ? q.S * q.fade.dphi_dh / q.Ms : 0.0;  // ∂c/∂|H_app|
+    const Vec3 dcx = kh * (q.Japp * q.Hhat);
+    const Vec3 radial = c * dW + W * dc * q.rhat;
+    (*F)[p.i] += kMu0 * (radial + 0.5 * W * dcx);
+    (*F)[p.j] += kMu0 * (-radial + 0.5 * W * dcx);
+    if (kh == 0) continue;
+    for (const int k : ws->perm) {
+      const Vec3& mk = set.m_perm[k];
+      const Vec3 rk = q.mid - set.position[k];
+      (*F)[k] -= kMu0 * W * kh * (dipole_jacobian(rk, mk) * q.Hhat);
+      if (tau) (*tau)[k] += kMu0 * W * kh * mk.cross(dipole_field(rk, q.Hhat));
+    }
+  }
+}
+
+}  // namespace magsim::mag

@@ -1,0 +1,141 @@
+// magnetics/near_field.hpp — the near-field pair model: two touching iron spheres coupled as
+// exact linear magnetostatics says, not as two point dipoles, faded as the contact saturates.
+//
+// One point dipole per ball is weakest where balls touch: in an axial field the dipole pair
+// attracts 2.8× too weakly at g = 0.1a and 36× at 0.003a (μr = 1000), and in a transverse
+// field it repels up to 42 % too strongly (magnetics/PHYSICS.md, "The near field"). The pair
+// model adds to every pair of induced spheres closer than kPairCutoffGap the energy
+//   E_ij = −μ0 c_ij m_iᵀ ΔT(r_ij) m_j,
+//   ΔT(r) = [Δt∥(g) r̂ r̂ᵀ + Δt⊥(g) (I − r̂ r̂ᵀ)] / a³,   c = S(g) φ(h),
+// in the co-energy's pair sum (coenergy.hpp), so that the field a ball feels from its partner
+// is (T + c ΔT) m_j and every force stays −∇U*:
+//   * Δt∥, Δt⊥: the exact two-sphere coupling corrections (tools/reference/
+//     near_field_table.py) that make the pair's linear polarizability C∥(d), C⊥(d) exact for
+//     the material's initial μr, so that two balls in a weak uniform field feel the exact
+//     linear force, axial, transverse and in between (the tangential force included);
+//   * g: the gap in radii, g = |r|/a − 2, taken through g_e = g_m + g_s ln(1 + e^{(g − g_m)/g_s}):
+//     g_e ≈ g from a few g_s above g_m on, and contact and every overlap read as g_m, a
+//     surface roughness. The well this leaves at contact is as wide as g_s: narrower ones
+//     made steps that the contact solver and the pull trade energy in (the energy guard's
+//     retakes could not resolve them at g_m = 1e-4, g_s = 2.5e-4);
+//   * S(g): 1 for g ≤ kPairFullGap, a quintic step to 0 at kPairCutoffGap (C² throughout);
+//   * φ(h) = 1/(1 + (h/h0)^p), h = |H_app|/Ms at the pair's midpoint, H_app the field of
+//     the permanent moments and H0 (not of the induced ones: φ must not depend on M, or the
+//     magnetization equation would change): the saturation of the contact region. h0 and p
+//     are fitted to a nonlinear finite-element solution (axial, g = 0.003a, μr = 1000, tanh
+//     curve) across H0/Ms = 1e-4…10 (tools/findings/near_field.md). h0 is the same at every
+//     gap: for the correction to attract, c Δt must fall as the gap opens, and an h0 that
+//     grows faster than about g^0.15 near contact would make the pair repel.
+// Eligible: induced moments that are the only moment of their body (group −1 or a group of
+// one), with a radius equal to the sphere of their volume, a = (3V/4π)^{1/3} (or no radius
+// set), pairs of equal radii. Every other pair keeps the dipole interaction.
+#pragma once
+
+#include "magnetics/moments.hpp"
+
+#include <string>
+#include <vector>
+
+namespace magsim::mag {
+
+/// The near-field model of induced sphere pairs.
+enum class NearField : std::uint8_t {
+  Dipole,  ///< one point dipole per ball, no correction (the default)
+  Pair     ///< the pair model above
+};
+inline constexpr NameTable<NearField, 2> kNearFieldNames{
+    {{NearField::Dipole, "dipole"}, {NearField::Pair, "pair"}}};
+
+struct NearFieldOptions {
+  NearField model = NearField::Dipole;
+  /// Initial relative permeability of the induced material, μr ∈ [10, 10000]: iron's is
+  /// in the hundreds to thousands (1000 here). Only the pair model reads it; the engine's
+  /// own law M = f(H) (initial slope 3) is μr = ∞.
+  double mu_r = 1000.0;
+};
+
+/// Empty when usable, else a one-line reason.
+std::string validate(const NearFieldOptions& o);
+
+/// The model's constants (gaps in radii, fields in Ms).
+inline constexpr double kPairFullGap = 1.0;       ///< S = 1 up to this gap
+inline constexpr double kPairCutoffGap = 2.0;     ///< S = 0 from this gap on: pure dipoles
+inline constexpr double kPairContactGap = 1.5e-3; ///< g_m: what contact reads as, 7.5 µm at a = 5 mm
+inline constexpr double kPairSmoothGap = 5e-4;    ///< g_s: the width of the step to g_m
+inline constexpr double kPairFadeField = 0.0138;  ///< h0 (|H_app|/Ms)
+inline constexpr double kPairFadePower = 1.2;     ///< p
+inline constexpr double kPairFadeGap = 0.003;     ///< the gap of the fit
+
+/// g_e of a gap g and dg_e/dg.
+double pair_effective_gap(double g, double* dge_dg = nullptr);
+
+/// Δt∥ a³, Δt⊥ a³ and their derivatives in g, for relative permeability mu_r at gap g (both
+/// in radii; g > −2). Interpolated: natural cubic splines in ln g_e through the table's
+/// nodes, linear in ln μr between its rows.
+struct PairCoupling {
+  double par = 0, perp = 0;    ///< Δt∥ a³, Δt⊥ a³
+  double dpar = 0, dperp = 0;  ///< their derivatives in g
+};
+class PairCouplingTable {
+ public:
+  explicit PairCouplingTable(double mu_r);
+  double mu_r() const { return mu_r_; }
+  PairCoupling at(double g) const;
+
+ private:
+  double mu_r_;
+  std::vector<double> par_, perp_, par2_, perp2_;  // node values and spline second derivatives
+};
+
+/// The saturation fade φ(h) and its derivative (dphi_dg: 0, h0 is gap-independent).
+struct PairFade {
+  double phi = 1, dphi_dh = 0, dphi_dg = 0;
+};
+PairFade pair_fade(double h, double g);
+/// The cut-off step S(g) and dS/dg.
+double pair_switch(double g, double* dS_dg = nullptr);
+
+/// A pair of eligible moments closer than the cut-off (i < j).
+struct NearPair {
+  int i, j;
+};
+/// Pair list and table, rebuilt per call (positions change every step); the table is kept
+/// while μr does not change.
+struct NearFieldWorkspace {
+  std::vector<NearPair> pairs;
+  std::vector<double> a;  ///< (n) sphere radius of each eligible moment, 0 = not eligible
+  std::vector<int> perm;  ///< the permanent moments (the sources of H_app)
+  std::vector<std::pair<long long, int>> cells;  ///< scratch: (grid cell, moment)
+  std::vector<PairCouplingTable> table;          ///< 0 or 1 entry
+  const PairCouplingTable& table_for(double mu_r);
+};
+
+/// Lists the eligible pairs (i < j, in that order) of `set` closer than the cut-off.
+void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws);
+
+/// The pair model's coupling of one near pair: the field at i is K m_j and at j is K m_i,
+/// K = c ΔT(r_ij) (symmetric, even in r; 1/m³).
+struct NearCoupling {
+  int i, j;
+  Mat3 K;
+};
+/// Every near pair's coupling (the Newton ground truth adds them to its interaction matrix).
+/// Depends on positions and permanent moments only. Empty for NearField::Dipole.
+void near_field_couplings(const MomentDesc& set, const NearFieldOptions& opt,
+                          NearFieldWorkspace* ws, std::vector<NearCoupling>* out);
+
+/// Adds the pair model's field c ΔT(r_ij) m_j to H_i and c ΔT m_i to H_j of every near pair
+/// (the field −(1/μ0) ∂E/∂m the magnetization feels). No-op for NearField::Dipole.
+void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
+                    NearFieldWorkspace* ws, std::vector<Vec3>* H);
+/// Σ E_ij (J), the pair model's part of U*. 0 for NearField::Dipole.
+double near_field_energy(const MomentDesc& set, const Magnetization& mz,
+                         const NearFieldOptions& opt, NearFieldWorkspace* ws);
+/// Adds −∂(Σ E_ij)/∂p to F of both balls of every pair and of every permanent moment (through
+/// H_app), and −∂/∂θ to τ of the permanent moments, at fixed magnetizations (the envelope
+/// theorem: U is stationary in M). Σ F = 0. No-op for NearField::Dipole.
+void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
+                           const NearFieldOptions& opt, NearFieldWorkspace* ws,
+                           std::vector<Vec3>* F, std::vector<Vec3>* tau);
+
+}  // namespace magsim::mag
