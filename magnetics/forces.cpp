@@ -3,6 +3,7 @@
 #include "magnetics/forces.hpp"
 
 #include "magnetics/curves.hpp"
+#include "magnetics/dipole_field.hpp"
 #include "magnetics/forces_total.hpp"
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 // magnetics/magnetization.hpp — magnetization dynamics (paper §3.2–3.3, magnetics/PHYSICS.md).
 #pragma once
 
-#include "magnetics/dipole_field.hpp"
+#include "magnetics/fields.hpp"
 
 #include <functional>
 #include <string>

@@ -3,7 +3,7 @@
 // leave the scene's FieldOptions as they are.
 #pragma once
 
-#include "magnetics/dipole_field.hpp"
+#include "magnetics/fields.hpp"
 #include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>

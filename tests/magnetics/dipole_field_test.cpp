@@ -2,6 +2,7 @@
 // (AVX-512 and portable paths, cache chunks, determinism).
 #include "magnetics/dipole_field.hpp"
 #include "magnetics/field_kernel.hpp"
+#include "magnetics/fields.hpp"
 #include "tests/magnetics/fixtures.hpp"
 
 #include <catch2/catch.hpp>
