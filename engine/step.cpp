@@ -23,6 +23,7 @@
 #include "engine/stages.hpp"
 #include "magnetics/coenergy.hpp"
 #include "magnetics/forces.hpp"
+#include "magnetics/forces_total.hpp"
 
 #include <omp.h>
 

@@ -73,8 +73,8 @@ struct AndersonHistory {
   double beta = 1.0;                    ///< current damping
 };
 
-/// Scratch and statistics of ForceModel::ZeemanTotal (forces.hpp). Reused across steps; w
-/// warm-starts the next adjoint solve.
+/// Scratch and statistics of ForceModel::ZeemanTotal (forces_total.hpp). Reused across
+/// steps; w warm-starts the next adjoint solve.
 struct ZeemanTotalScratch {
   std::vector<int> idx;            ///< (k) induced moment indices
   std::vector<Mat3> B;             ///< (k) (V A)^{1/2}

@@ -5,6 +5,7 @@
 #include "magnetics/dipole_field.hpp"
 #include "magnetics/field_kernel.hpp"
 #include "magnetics/fields.hpp"
+#include "magnetics/force_laws.hpp"
 #include "magnetics/forces.hpp"
 #include "tests/magnetics/fixtures.hpp"
 

@@ -3,6 +3,7 @@
 #include "magnetics/forces.hpp"
 #include "magnetics/curves.hpp"
 #include "magnetics/dipole_field.hpp"
+#include "magnetics/force_laws.hpp"
 #include "magnetics/ground_truth.hpp"
 #include "tests/magnetics/fixtures.hpp"
 
