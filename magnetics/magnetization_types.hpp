@@ -1,7 +1,7 @@
 // magnetics/magnetization_types.hpp — what the magnetization solvers share: their options
-// (DynamicsOptions), their workspace (MagWorkspace) and statistics (RelaxStats).
-// Below the dispatcher magnetization.hpp and the solver it dispatches to (anderson.hpp), so
-// that both include this and neither includes the other's header upward.
+// (DynamicsOptions), their workspace (MagWorkspace, also the forces' scratch) and statistics
+// (RelaxStats). It sits below magnetization.hpp and the solver that one dispatches to,
+// anderson.hpp: both include it, so Anderson needs nothing from the header above it.
 #pragma once
 
 #include "magnetics/fields.hpp"
