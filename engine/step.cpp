@@ -23,6 +23,7 @@
 #include "engine/stages.hpp"
 #include "magnetics/coenergy.hpp"
 #include "magnetics/forces.hpp"
+#include "magnetics/forces_total.hpp"
 
 #include <omp.h>
 
@@ -53,7 +54,7 @@ class OmpThreadScope {
 double Simulation::coenergy(const mag::Magnetization& mz) const {
   const Model& m = *model_;
   if (ws_.mag.H.size() != moments_.size()) return 0.0;
-  // the potential of the force where it has its own (zeeman-total: E_sys, forces.hpp)
+  // the potential of the force where it has its own (zeeman-total: E_sys, forces_total.hpp)
   if (resolved_force_model(m.options) == mag::ForceModel::ZeemanTotal)
     return mag::zeeman_total_energy(moments_, mz, mag::curve_of(m.options.magnetics.method), ws_.mag.H,
                                     ws_.mag.total.perm, ws_.mag.total.Hp);

@@ -2,9 +2,13 @@
 // magnetization M = f(H(M)) (eq. 10 curve, magnetics/PHYSICS.md) directly, by Picard iteration
 // M ← f(H(M)) accelerated with Anderson mixing. Each iteration costs one field evaluation,
 // like one Jacobi sweep of the dynamics, so iteration counts compare one to one.
+// A solver below its dispatcher (relax_magnetization, magnetization.hpp): it includes the
+// shared types of magnetization_types.hpp, never magnetization.hpp.
 #pragma once
 
-#include "magnetics/magnetization.hpp"
+#include "magnetics/magnetization_types.hpp"
+
+#include <functional>
 
 namespace magsim::mag {
 

@@ -4,12 +4,12 @@
 // their types in barnes_hut_internal.hpp.
 //
 // The moments are sorted along a Morton curve and split into an octree whose leaves hold at
-// most `bh_leaf_size` moments. Every cell carries the multipole of its nonzero source moments
+// most `leaf_size` moments. Every cell carries the multipole of its nonzero source moments
 // about a centre c that does not depend on the moments — their centre weighted by their
 // largest possible moments, V_i Ms_i (induced) or |m_i| (permanent) (d_i = p_i − c):
 //   M = Σ m_i (dipole), S = sym Σ d_i ⊗ m_i (quadrupole order),
-//   O = sym Σ d_i ⊗ d_i ⊗ m_i (octupole order, with bh_order = 2).
-// Targets come in groups of at most `bh_group_size` (a small subtree, or sibling subtrees
+//   O = sym Σ d_i ⊗ d_i ⊗ m_i (octupole order, with order = 2).
+// Targets come in groups of at most `group_size` (a small subtree, or sibling subtrees
 // packed together). One walk of the tree per group lists the cells that every target of the
 // group sees under an angle below θ (b < θ (R − b_t): b the cell's radius about c, R the
 // distance from c to the group's centre, b_t the group's radius — the multipole acceptance
@@ -27,7 +27,7 @@
 // Work per group does not depend on the thread that does it, so results are deterministic
 // whatever the thread count.
 //
-// Near field in single precision (FieldOptions::bh_near_float, θ > 0): a group's near
+// Near field in single precision (BarnesHutOptions::near_float, θ > 0): a group's near
 // sources are gathered as float arrays with positions relative to the group's centre g.tc
 // (the double difference rounded: ~1e-9 m for sources a few cm away; absolute coordinates
 // never go to float), moments in float, ids and groups as int32 for the masks, padded to
@@ -35,12 +35,12 @@
 // totals in double). The sources' moments are converted to float once per call and their
 // ids and groups to int32 once per tree, so the gather converts positions only.
 //
-// Far cells in single precision (FieldOptions::bh_far_float, with the float near field):
+// Far cells in single precision (BarnesHutOptions::far_float, with the float near field):
 // a group's cells are gathered into CellBufferF — centres relative to g.tc, every field in
 // the group's length unit L (a power of two from the cells' distances, far_scale; chosen
 // with the lists, so the same for fresh and reused geometry) — and summed by far_sum (barnes_hut_far.cpp)
 // (the same series in float, 16 lanes; partial sums in float per chunk, totals in double,
-// then × 1/(4π L³) or 1/(4π L⁴)). Otherwise (bh_far_float or bh_near_float false) the
+// then × 1/(4π L³) or 1/(4π L⁴)). Otherwise (far_float or near_float false) the
 // far cells stay in double.
 //
 // Reuse: the magnetization solvers evaluate the fields 5–35 times per step at the same
@@ -63,19 +63,18 @@ using namespace bh;
 
 BarnesHutWorkspace* new_barnes_hut_workspace() { return new BarnesHutWorkspace; }
 
-void barnes_hut_forget_geometry(FieldWorkspace* ws) {
-  if (!ws->bh) return;
-  ws->bh->tree_valid = false;
-  ws->bh->lists_valid[0] = ws->bh->lists_valid[1] = false;
-}
 void BarnesHutWorkspaceDeleter::operator()(BarnesHutWorkspace* p) const { delete p; }
 
-BarnesHutStats barnes_hut_stats(const FieldWorkspace& ws) {
-  return ws.bh ? ws.bh->stats : BarnesHutStats{};
+void barnes_hut_forget_geometry(BarnesHutWorkspace* ws) {
+  ws->tree_valid = false;
+  ws->lists_valid[0] = ws->lists_valid[1] = false;
 }
 
-void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
-                       std::vector<Vec3>* H, std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
+BarnesHutStats barnes_hut_stats(const BarnesHutWorkspace& ws) { return ws.stats; }
+
+void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz,
+                       const BarnesHutOptions& opt, std::vector<Vec3>* H, std::vector<Mat3>* J,
+                       BarnesHutWorkspace* ws) {
   const auto t_start = std::chrono::steady_clock::now();
   const int n = static_cast<int>(set.size());
   H->resize(n);
@@ -90,7 +89,7 @@ void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const Fie
     ws->nz[i] = !(m.x() == 0.0 && m.y() == 0.0 && m.z() == 0.0);
     ws->w[i] = set.kind[i] == MomentKind::Induced ? set.volume[i] * set.Ms[i] : m.norm();
   }
-  const int leaf = std::max(1, opt.bh_leaf_size), gsize = std::max(1, opt.bh_group_size);
+  const int leaf = std::max(1, opt.leaf_size), gsize = std::max(1, opt.group_size);
   const bool same_tree =
       ws->tree_valid && static_cast<int>(ws->key_pos.size()) == n && ws->key_leaf == leaf &&
       ws->key_group == gsize && ws->key_nz == ws->nz &&
@@ -117,20 +116,20 @@ void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const Fie
   const double eps2 = opt.softening * opt.softening;
   const float eps2f = static_cast<float>(eps2);
   // θ = 0 promises the direct sum: the near field (then everything) stays in double
-  const bool near_float = opt.bh_near_float && opt.bh_theta > 0;
-  // the far cells in float too (only with the near field in float: bh_near_float = false
+  const bool near_float = opt.near_float && opt.theta > 0;
+  // the far cells in float too (only with the near field in float: near_float = false
   // keeps the whole sum in double)
-  const bool far_float = near_float && opt.bh_far_float;
+  const bool far_float = near_float && opt.far_float;
   const bool want_J = J != nullptr;
   const int mode = want_J ? 1 : 0;
   // bounded pairs: near leaves carry the radii; far cells keep 2 a_max of clearance
-  const bool bounded = pairs_bounded(set, opt);
+  const bool bounded = opt.bounded;
   double min_gap = 0.0;
   if (bounded)
     for (double a : set.radius) min_gap = std::max(min_gap, 2.0 * a);
-  const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.bh_theta ||
+  const bool new_lists = !ws->lists_valid[mode] || ws->lists_theta[mode] != opt.theta ||
                          ws->lists_gap[mode] != min_gap;
-  const int order = opt.bh_order;
+  const int order = opt.order;
   const int nthreads = omp_get_max_threads();
   if (static_cast<int>(ws->threads.size()) < nthreads) ws->threads.resize(nthreads);
   for (ThreadScratch& th : ws->threads) {
@@ -147,7 +146,7 @@ void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const Fie
     for (long l = 0; l < ngroups; ++l) {
       const Group& g = ws->groups[l];
       const auto t_l0 = std::chrono::steady_clock::now();
-      if (new_lists) build_lists(*ws, g, opt.bh_theta, min_gap, want_J, &th.stack, &lists[l]);
+      if (new_lists) build_lists(*ws, g, opt.theta, min_gap, want_J, &th.stack, &lists[l]);
       th.lists_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_l0).count();
       gather(*ws, g, lists[l], near_float, far_float, &th);
       const detail::SourceView vn = detail::view_of(th.near, bounded, 0, th.near.size()),
@@ -211,7 +210,7 @@ void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const Fie
     }
   }
   ws->lists_valid[mode] = true;
-  ws->lists_theta[mode] = opt.bh_theta;
+  ws->lists_theta[mode] = opt.theta;
   ws->lists_gap[mode] = min_gap;
   const auto t_end = std::chrono::steady_clock::now();
   BarnesHutStats& st = ws->stats;

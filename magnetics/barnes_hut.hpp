@@ -1,5 +1,7 @@
-// magnetics/barnes_hut.hpp — Barnes–Hut far-field approximation of compute_fields
-// (FieldSolver::BarnesHut, or FieldSolver::Auto from FieldOptions::auto_threshold moments).
+// magnetics/barnes_hut.hpp — Barnes–Hut far-field approximation of the dipole sums, the
+// kernel compute_fields (fields.hpp) runs for FieldSolver::BarnesHut, or for FieldSolver::Auto
+// from FieldOptions::auto_threshold moments. It takes its own options (BarnesHutOptions,
+// filled by the dispatcher) and includes nothing of fields.hpp.
 //
 // An octree of the moments; each cell carries its dipole moment and the quadrupole- and
 // octupole-order terms about a fixed centre (its sources' centre weighted by their largest
@@ -16,18 +18,37 @@
 // tests/magnetics/barnes_hut_test): relative field error RMS ≤ 1e-3 over all targets
 // (√(Σ|ΔH_j|²/Σ|H_j|²)), max_j |ΔH_j|/|H_j| ≤ 2e-2 on piles and clouds (larger only where
 // |H_j| nearly cancels, e.g. flat sheets); J: RMS ≤ 2e-3. The single-precision near field and
-// far cells (bh_near_float, bh_far_float) add < 2e-6 and < 1e-5 RMS. Measured figures and
+// far cells (near_float, far_float) add < 2e-6 and < 1e-5 RMS. Measured figures and
 // speeds: README.md, "Benchmarks".
 #pragma once
 
-#include "magnetics/dipole_field.hpp"
+#include "magnetics/moments.hpp"
+
+#include <vector>
 
 namespace magsim::mag {
 
+/// What Barnes–Hut takes of the field options. compute_fields fills it from FieldOptions,
+/// which documents each one; the defaults here are FieldOptions' defaults.
+struct BarnesHutOptions {
+  double softening = 0.0;  ///< softening length ε (m), FieldOptions::softening
+  bool bounded = false;    ///< sum as bounded pairs (pairs_bounded of fields.hpp)
+  double theta = 0.3;      ///< opening angle θ ∈ [0, 1], FieldOptions::bh_theta
+  int leaf_size = 64;      ///< moments per octree leaf at most, FieldOptions::bh_leaf_size
+  int group_size = 32;     ///< targets per interaction list, FieldOptions::bh_group_size
+  int order = 2;           ///< expansion order 1 or 2, FieldOptions::bh_order
+  bool near_float = true;  ///< near field in single precision, FieldOptions::bh_near_float
+  bool far_float = true;   ///< far cells in single precision, FieldOptions::bh_far_float
+};
+
 /// Octree, multipoles and per-thread scratch; reused across calls.
 struct BarnesHutWorkspace;
-/// A new, empty workspace (owned by FieldWorkspace::bh).
+/// A new, empty workspace (owned by FieldWorkspace::bh through BarnesHutWorkspaceDeleter).
 BarnesHutWorkspace* new_barnes_hut_workspace();
+/// Deletes a workspace of new_barnes_hut_workspace (the type is complete only here).
+struct BarnesHutWorkspaceDeleter {
+  void operator()(BarnesHutWorkspace* p) const;
+};
 
 /// What the last Barnes–Hut evaluation did (for benchmarks).
 struct BarnesHutStats {
@@ -41,18 +62,19 @@ struct BarnesHutStats {
   double lists_s = 0;                 ///< of eval_s: building the lists (s, summed over threads)
 };
 /// The statistics of the last Barnes–Hut evaluation with this workspace (zeros if none).
-BarnesHutStats barnes_hut_stats(const FieldWorkspace& ws);
+BarnesHutStats barnes_hut_stats(const BarnesHutWorkspace& ws);
 
 /// Drops the cached octree and interaction lists, so that the next evaluation builds them
 /// anew (benchmarks time the fresh build with it; results are the same either way).
-void barnes_hut_forget_geometry(FieldWorkspace* ws);
+void barnes_hut_forget_geometry(BarnesHutWorkspace* ws);
 
 /// H (and J) at every moment as compute_fields does, far cells approximated. Called by
 /// compute_fields when the options select Barnes–Hut.
-void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
-                       std::vector<Vec3>* H, std::vector<Mat3>* J, BarnesHutWorkspace* ws);
-inline void barnes_hut_fields(const MomentSet& set, const FieldOptions& opt, std::vector<Vec3>* H,
-                              std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
+void barnes_hut_fields(const MomentDesc& set, const Magnetization& mz,
+                       const BarnesHutOptions& opt, std::vector<Vec3>* H, std::vector<Mat3>* J,
+                       BarnesHutWorkspace* ws);
+inline void barnes_hut_fields(const MomentSet& set, const BarnesHutOptions& opt,
+                              std::vector<Vec3>* H, std::vector<Mat3>* J, BarnesHutWorkspace* ws) {
   barnes_hut_fields(set, set, opt, H, J, ws);
 }
 

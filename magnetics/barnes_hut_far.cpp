@@ -1,7 +1,7 @@
 // magnetics/barnes_hut_far.cpp — the far-cell series of Barnes–Hut (barnes_hut.cpp): one
 // body for the AVX-512 kernel (far_block) and one for the portable loop, each instantiated
 // in double (CellBuffer, 8 cells per block) and in single precision (CellBufferF, 16 cells
-// per block, FieldOptions::bh_far_float).
+// per block, BarnesHutOptions::far_float).
 #include "magnetics/barnes_hut_internal.hpp"
 #include "magnetics/simd.hpp"
 
@@ -24,7 +24,7 @@ namespace {
 //   4π J = A I + r Kᵀ + K rᵀ − 6 u5 S − 45 u7 o1
 // With order 1 every O term is dropped (τ = o3 = 0, t = o1 = o2 = 0).
 //
-// In single precision (FieldOptions::bh_far_float) the same series runs on a group's scaled
+// In single precision (BarnesHutOptions::far_float) the same series runs on a group's scaled
 // cells (CellBufferF: r' = r/L, S' = S/L, O' = O/L², so the sums below are L³ · 4π h and L⁴ · 4π J;
 // sH = 1/(4π L³) and sJ = 1/(4π L⁴) undo both in double). 1/√q: vrsqrt14ps refined by one
 // Newton–Raphson step (≈ 1.5·2⁻²⁸, below float rounding) on AVX-512, 1/std::sqrt in the

@@ -96,7 +96,7 @@ struct CellBuffer {
   }
 };
 
-// The same in float (FieldOptions::bh_far_float), blocks of 16 cells ([block][field][lane]),
+// The same in float (BarnesHutOptions::far_float), blocks of 16 cells ([block][field][lane]),
 // as one group's kernel reads them: every field scaled to the group's length unit L (a power
 // of two, GroupLists::far_inv_scale = 1/L; see far_scale): the centre relative to the group's
 // centre g.tc, c' = (c − g.tc)/L (the double difference, scaled exactly, then rounded —
@@ -137,7 +137,7 @@ struct CellBufferF {
 // Near sources gathered for one group: whole leaves copied from the tree-ordered arrays.
 using NearBuffer = detail::SourceBuffer;
 
-// The same, in float for sum_pairs_f32 (FieldOptions::bh_near_float): positions relative
+// The same, in float for sum_pairs_f32 (BarnesHutOptions::near_float): positions relative
 // to the group's centre (converted from the double difference; never absolute coordinates
 // in float), moments, and the ids and groups as int32 for the masks.
 struct NearBufferF {
@@ -201,9 +201,9 @@ struct GroupLists {
 
 struct ThreadScratch {
   NearBuffer near, near_j;                  // exact sources: H and J / J only
-  NearBufferF nearf, nearf_j;               // the same in float (bh_near_float)
+  NearBufferF nearf, nearf_j;               // the same in float (near_float)
   CellBuffer far_hj, far_h, far_j;          // cells: field and Jacobian / field only / J only
-  CellBufferF far_hjf, far_hf, far_jf;      // the same in float, scaled (bh_far_float)
+  CellBufferF far_hjf, far_hf, far_jf;      // the same in float, scaled (far_float)
   std::vector<std::pair<int, bool>> stack;  // (node, J-only)
   long near_pairs = 0, far_cells = 0;       // interaction counts (statistics)
   double lists_s = 0;                       // time spent building lists (statistics)
@@ -251,7 +251,7 @@ namespace bh {
 
 /// Sorts the moments along the Morton curve, splits the octree, sets each node's centre and
 /// radius and forms the target groups (the geometry: kept while its keys are unchanged).
-void build_tree(const MomentDesc& set, const FieldOptions& opt, BarnesHutWorkspace* ws);
+void build_tree(const MomentDesc& set, const BarnesHutOptions& opt, BarnesHutWorkspace* ws);
 /// This call's moments into the packed sources and every cell's multipole (bottom-up).
 void update_multipoles(const MomentDesc& set, const Magnetization& mz, BarnesHutWorkspace* ws);
 

@@ -245,7 +245,7 @@ void find_shared(const MomentDesc& set, BarnesHutWorkspace* ws) {
 
 // The geometry: Morton order, octree, node centres and radii, target groups. Depends on the
 // positions, groups, which moments are nonzero, and the leaf and group sizes only.
-void build_tree(const MomentDesc& set, const FieldOptions& opt, BarnesHutWorkspace* ws) {
+void build_tree(const MomentDesc& set, const BarnesHutOptions& opt, BarnesHutWorkspace* ws) {
   const int n = static_cast<int>(set.size());
   find_shared(set, ws);
   // Morton codes on the bounding cube, sorted (ties by index: deterministic)
@@ -294,7 +294,7 @@ void build_tree(const MomentDesc& set, const FieldOptions& opt, BarnesHutWorkspa
 
   ws->nodes.assign(1, Node{});
   ws->nodes[0].t1 = n;
-  split_node(ws, 0, 0, std::max(1, opt.bh_leaf_size));
+  split_node(ws, 0, 0, std::max(1, opt.leaf_size));
   // geometry bottom-up (children have larger indices than their parent)
   const int nn = static_cast<int>(ws->nodes.size());
   for (int id = nn - 1; id >= 0; --id) {
@@ -310,7 +310,7 @@ void build_tree(const MomentDesc& set, const FieldOptions& opt, BarnesHutWorkspa
                           nd.gmin, nd.gmax, nd.gmask};
   }
   ws->groups.clear();
-  make_groups(set, ws, 0, std::max(1, opt.bh_group_size));
+  make_groups(set, ws, 0, std::max(1, opt.group_size));
 }
 
 // The moments of this call: sources' moments, multipoles bottom-up, the kernel's cells.

@@ -1,11 +1,12 @@
-// magnetics/field_kernel.hpp — internal: the packed-source layout and the SIMD pair kernel
-// behind compute_fields (dipole_field.cpp) and the near field of Barnes–Hut (barnes_hut.cpp),
-// in double and in single precision (both in pair_kernel.cpp).
+// magnetics/field_kernel.hpp — internal: the SIMD pair kernel behind the direct sum
+// (dipole_field.cpp) and the near field of Barnes–Hut (barnes_hut.cpp), in double and in
+// single precision (both in pair_kernel.cpp), over the packed sources of source_buffer.hpp.
 // Not part of the public API: include only from magnetics/*.cpp (and the kernel's own
-// tests and benchmark).
+// tests and benchmark). It sits below both field sums and their dispatcher (fields.hpp), so
+// it includes none of their headers.
 #pragma once
 
-#include "magnetics/dipole_field.hpp"
+#include "magnetics/source_buffer.hpp"
 #include "magnetics/types.hpp"
 
 #include <cstddef>
@@ -26,14 +27,8 @@ namespace magsim::mag::detail {
 
 inline constexpr double kInv4Pi = 1.0 / (4.0 * kPi);  ///< 1/4π of eq. 1
 
-/// Sources are padded to a multiple of this with zero moments far away (they add exactly 0).
-inline constexpr std::size_t kSourcePad = 8;
-/// Position of a padding source or cell (m): far enough to never matter, near enough that
-/// every power of 1/|r| the kernels form (up to 1/|r|¹¹) stays a normal double; its zero
-/// moment makes every term exactly zero.
-inline constexpr double kPadPosition = 1e15;
-
-/// A read-only view of padded source arrays (as FieldWorkspace's or a gathered copy).
+/// A read-only view of padded source arrays (the direct sum's packed sources or a gathered
+/// copy).
 struct SourceView {
   const double *x, *y, *z, *mx, *my, *mz, *id, *grp;
   std::size_t n;  ///< a multiple of kSourcePad
@@ -74,7 +69,7 @@ enum class PairTerms { H, HJ };
 void sum_pairs(const SourceView& v, const Target& t, double eps2, PairTerms terms, double* H,
                double* J);
 
-// ---- single precision (Barnes–Hut near field, FieldOptions::bh_near_float) ---------------
+// ---- single precision (Barnes–Hut near field, BarnesHutOptions::near_float) -------------
 
 /// Float sources are padded to a multiple of this (one AVX-512 register of floats).
 inline constexpr std::size_t kSourcePadF = 16;

@@ -1,26 +1,13 @@
 // magnetics/forces.hpp — magnetic forces and torques on moments (paper eqs. 4, 13–14).
+// The dispatcher of the force models: ForceModel::ZeemanTotal goes down to forces_total.hpp,
+// and both use the one-moment formulas of force_laws.hpp.
 #pragma once
 
-#include "magnetics/magnetization.hpp"
+#include "magnetics/magnetization_types.hpp"
+
+#include <vector>
 
 namespace magsim::mag {
-
-/// Zeeman force on an induced moment (ours, eq. 4, derived with the sources held fixed):
-///   E = −μ0 V M·(M + H), M = f(H(p))
-///   F = −∂E/∂p = μ0 V J [ A (2M + H) + M ],  A = ∂M/∂H (symmetric), J = ∂H/∂p (symmetric).
-/// The printed eq. 4 reads A J (2M + H); the chain rule gives J A (2M + H) — the two
-/// differ when A is anisotropic (near saturation). Proven by a finite-difference test.
-Vec3 zeeman_force(Curve curve, double V, double Ms, const Vec3& M, const Vec3& H, const Mat3& J);
-/// The magnetization in eq. 4's bracket, A (2M + H) + M (A = ∂M/∂H at H): the induced moment's
-/// "effective" magnetization, −∂e/∂H / (μ0 V) with e its Zeeman energy. Used by the Zeeman
-/// force, its reaction-symmetric form and ZeemanTotal.
-inline Vec3 zeeman_effective_magnetization(const Mat3& A, const Vec3& M, const Vec3& H) {
-  return A * (2.0 * M + H) + M;
-}
-/// Zeeman energy of one induced moment at equilibrium, E = −μ0 V f(H)·(f(H) + H) (eq. 3–4).
-double zeeman_energy(Curve curve, double V, double Ms, const Vec3& H);
-/// Classic force (eq. 13): F = μ0 (m·∇) H = μ0 J m, m held constant.
-Vec3 classic_force(const Vec3& m, const Mat3& J);
 
 /// Forces (N) and torques (N·m) on every moment from the fields in ws (the fields and
 /// Jacobians are evaluated here from the current magnetizations, into ws->H and ws->J).
@@ -52,28 +39,11 @@ Vec3 classic_force(const Vec3& m, const Mat3& J);
 /// conserved up to the torques the pair energy would put on induced moments,
 /// ½ μ0 Σ m_j × H̃_j over induced j (a test measures it).
 ///
-/// ForceModel::ZeemanTotal — eq. 4 taken over the whole system ("magnetic moments and
-/// equivalently magnetizations are taken as variables", §6.1): the forces are the exact
-/// negative gradient of
-///   E_sys = Σ_{i induced} e_i(H_i) + U_pp,   e_i = −μ0 V_i f(H_i)·(f(H_i) + H_i)  (eqs. 3–4),
-///   U_pp = −μ0 [½ Σ_p m_p·H^perm_p + Σ_p m_p·H0]   (permanent pairs, the physical energy),
-/// with every induced M_j = f(H_j) at equilibrium, so a change of one position moves every
-/// magnetization. eq. 4's per-moment force is the part of this gradient where the sources
-/// stay fixed; what it leaves out (the neighbours' energies and magnetizations) makes it
-/// non-conservative in a pile: measured in falling_magnet, eq. 4 does 2.7× the work of the
-/// energy it releases (tools/findings/energy.md). The gradient, by the adjoint method:
-///   m̃_i = V_i [A_i (2M_i + H_i) + M_i]                       (−∂e_i/∂H_i / μ0)
-///   λ̃ = m̃ + V A T λ̃   (T: the dipole field of moments at induced moments, eq. 1)
-///   F_k = μ0 [J_kᵀ λ̃_k + J̃_kᵀ m_k]          (k induced; J̃ = ∂H̃/∂p, H̃ the field of λ̃)
-///   F_p = μ0 (J̃_p + J^perm_p)ᵀ m_p,  τ_p = μ0 m_p × (H̃_p + H^perm_p)   (p permanent)
-/// For one induced moment in a fixed field λ̃ = m̃ and F is eq. 4 exactly. Σ F = 0 (E_sys
-/// is translation invariant). The adjoint system is solved symmetrically, with
-/// B = (V A)^{1/2} and λ̃ = m̃ + B w: (I − B T B) w = B T m̃ by conjugate gradients
-/// (I − B T B is positive definite where the magnetization equilibrium is stable),
-/// warm-started from the last call, to |residual| ≤ total_tol |right side|; each CG
-/// iteration is one field evaluation. Statistics in ws->total. reaction_symmetric is
-/// ignored (momentum is conserved already). Same-body pairs (one group) add no force, as for
-/// the other models.
+/// ForceModel::ZeemanTotal — eq. 4 taken over the whole system: the exact negative gradient
+/// of the system's Zeeman energy E_sys with every magnetization re-solved (the derivation and
+/// its adjoint solve: forces_total.hpp). The adjoint conjugate gradients stop at |residual| ≤
+/// total_tol |right side| or after total_max_iter iterations (one field evaluation each);
+/// statistics in ws->total. reaction_symmetric is ignored (momentum is conserved already).
 void compute_forces(const MomentDesc& set, const Magnetization& mz, ForceModel model,
                     Curve curve, const FieldOptions& field, MagWorkspace* ws,
                     std::vector<Vec3>* F, std::vector<Vec3>* tau,
@@ -86,25 +56,6 @@ inline void compute_forces(const MomentSet& set, ForceModel model, Curve curve,
                            int total_max_iter = 100) {
   compute_forces(set, set, model, curve, field, ws, F, tau, F_classic, reaction_symmetric,
                  total_tol, total_max_iter);
-}
-
-/// E_sys of ForceModel::ZeemanTotal at the magnetizations in `set` (the equilibrium ones:
-/// the force is its gradient there). J.
-double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
-                           const FieldOptions& field, FieldWorkspace* ws);
-inline double zeeman_total_energy(const MomentSet& set, Curve curve, const FieldOptions& field,
-                                  FieldWorkspace* ws) {
-  return zeeman_total_energy(set, set, curve, field, ws);
-}
-/// The same from fields already evaluated: H at every moment, Hp the permanent moments' own
-/// field (with H0) at the permanent moments perm (ws->total.perm and .Hp after a
-/// ZeemanTotal force evaluation).
-double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
-                           const std::vector<Vec3>& H, const std::vector<int>& perm,
-                           const std::vector<Vec3>& Hp);
-inline double zeeman_total_energy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H,
-                                  const std::vector<int>& perm, const std::vector<Vec3>& Hp) {
-  return zeeman_total_energy(set, set, curve, H, perm, Hp);
 }
 
 }  // namespace magsim::mag

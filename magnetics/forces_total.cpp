@@ -1,9 +1,9 @@
 // magnetics/forces_total.cpp — eq. 4 as the gradient of the system's Zeeman energy
-// (ForceModel::ZeemanTotal; the derivation is at compute_forces in forces.hpp).
+// (ForceModel::ZeemanTotal; the derivation is at the top of forces_total.hpp).
 #include "magnetics/forces_total.hpp"
 
 #include "magnetics/curves.hpp"
-#include "magnetics/forces.hpp"
+#include "magnetics/force_laws.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -165,7 +165,7 @@ void zeeman_total_forces(const MomentDesc& set, const Magnetization& mz, Curve c
 
 }  // namespace detail
 
-// E_sys = Σ_{i induced} e_i(H_i) + U_pp (forces.hpp), from the field at every moment and
+// E_sys = Σ_{i induced} e_i(H_i) + U_pp (forces_total.hpp), from the field at every moment and
 // the permanent moments' own field Hp at the permanent moments perm
 double zeeman_total_energy(const MomentDesc& set, const Magnetization& mz, Curve curve,
                            const std::vector<Vec3>& H, const std::vector<int>& perm,

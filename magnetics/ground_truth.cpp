@@ -7,6 +7,7 @@
 #include "magnetics/ground_truth.hpp"
 
 #include "magnetics/curves.hpp"
+#include "magnetics/dipole_field.hpp"
 #include "magnetics/near_field.hpp"
 
 #include <Eigen/Dense>

@@ -48,7 +48,7 @@ enum class ForceModel : std::uint8_t {
   Zeeman,
   Classic,  ///< eqs. 13–14: F = μ0 J m, m held constant
   /// eq. 4 as the gradient of the system's Zeeman energy with every magnetization a variable
-  /// (forces.hpp, compute_forces): conservative, momentum-conserving; compute_forces'
+  /// (forces_total.hpp): conservative, momentum-conserving; compute_forces'
   /// reaction-symmetric pairing has no effect on it
   ZeemanTotal
 };

@@ -32,7 +32,9 @@
 // (--moments random, the hard case for multipoles).
 #include "magnetics/barnes_hut.hpp"
 #include "magnetics/curves.hpp"
+#include "magnetics/dipole_field.hpp"
 #include "magnetics/field_kernel.hpp"
+#include "magnetics/fields.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -4,7 +4,7 @@
 // as they are.
 #pragma once
 
-#include "magnetics/dipole_field.hpp"
+#include "magnetics/fields.hpp"
 #include "tools/cli_common.hpp"
 
 #include <CLI/CLI.hpp>

@@ -11,20 +11,27 @@ Prints one line per finding, FILE:LINE: what is wrong, and exits 1 when there is
   * any text file that points into a sibling checkout (a relative path climbing out of the
     repository into "shared"), or refers to an issue or pull request by its number: a
     reader of this repository can open neither. Cite a file in it instead, such as
-    magnetics/PHYSICS.md or tools/findings/*.md.
+    magnetics/PHYSICS.md or tools/findings/*.md;
+  * a kernel file of magnetics/ that includes, directly or through other headers, the
+    header of the module that dispatches to it (LAYERS: the direct sum and Barnes-Hut below
+    fields.hpp, Anderson below magnetization.hpp, ZeemanTotal below forces.hpp): a driver
+    sits above its kernels, so that a kernel can be read, tested and changed on its own.
 
 An issue reference is the word issue followed by a number (with or without a hash), or a
 hash and a number standing as a word of its own (after a space, bracket or line start).
 Hex colours, C preprocessor lines, shell comments, HTML entities and commit hashes do not
 look like that. Skipped: .git, out/, build directories (build, build-*, build_*), every
 --exclude directory and binary files (a NUL byte in the first 8 KiB). ROOT defaults to the
-repository holding this script. --self-test checks the patterns on examples and exits 0
-when they all behave. Exit 2: bad usage or a failed self-test.
+repository holding this script. --self-test checks the patterns on examples, and the include
+rule on a small tree, and exits 0 when they all behave. Exit 2: bad usage or a failed self-test.
 """
 import argparse
+import fnmatch
 import os
 import re
+import shutil
 import sys
+import tempfile
 
 MAX_LINES = 600
 SOURCE_DIRS = ("engine", "magnetics", "render", "scenes", "tests", "tools")
@@ -40,6 +47,86 @@ RULES = [
     (re.compile(r"(?:^|(?<=[\s(\[{,;]))#\d{1,5}\b"),
      "an issue reference by number; cite a file in this repository"),
 ]
+
+
+# The include rule of magnetics/: (files, headers they must not reach through #include, why).
+# Each header named sits above those files: the module that dispatches to them, or one that
+# builds on them.
+LAYERS = [
+    (("magnetics/source_buffer.*", "magnetics/field_kernel.hpp", "magnetics/pair_kernel.cpp",
+      "magnetics/simd.hpp", "magnetics/dipole_field.*", "magnetics/barnes_hut*"),
+     ("magnetics/fields.hpp",),
+     "fields.hpp dispatches to the direct sum and to Barnes-Hut"),
+    (("magnetics/source_buffer.*", "magnetics/field_kernel.hpp", "magnetics/pair_kernel.cpp",
+      "magnetics/simd.hpp"),
+     ("magnetics/dipole_field.hpp",),
+     "the pair kernel sits below the direct sum that calls it"),
+    (("magnetics/anderson.*", "magnetics/magnetization_types.hpp"),
+     ("magnetics/magnetization.hpp",),
+     "magnetization.cpp dispatches to Anderson"),
+    (("magnetics/magnetization_types.hpp",),
+     ("magnetics/anderson.hpp",),
+     "magnetization_types.hpp sits below Anderson and its dispatcher"),
+    (("magnetics/forces_total.*", "magnetics/force_laws.*"),
+     ("magnetics/forces.hpp",),
+     "forces.cpp dispatches to ZeemanTotal"),
+    (("magnetics/force_laws.*",),
+     ("magnetics/forces_total.hpp",),
+     "force_laws.hpp sits below both force modules"),
+]
+INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
+
+
+def local_includes(root, rel):
+    """(line number, path) of each quoted #include of rel that names a file under root."""
+    try:
+        with open(os.path.join(root, rel), encoding="utf-8", errors="replace") as f:
+            lines = f.read().splitlines()
+    except OSError:
+        return []
+    found = []
+    for number, line in enumerate(lines, 1):
+        m = INCLUDE.match(line)
+        if m and os.path.isfile(os.path.join(root, m.group(1))):
+            found.append((number, m.group(1)))
+    return found
+
+
+def include_chain(root, start, targets):
+    """The include path from header start to one of targets (a list, start first), or None."""
+    seen = {start}
+    queue = [[start]]
+    while queue:
+        chain = queue.pop(0)
+        if chain[-1] in targets:
+            return chain
+        for _, inc in local_includes(root, chain[-1]):
+            if inc not in seen:
+                seen.add(inc)
+                queue.append(chain + [inc])
+    return None
+
+
+def check_layers(root):
+    """Findings of LAYERS: a kernel file that reaches a forbidden header through #include."""
+    folder = os.path.join(root, "magnetics")
+    if not os.path.isdir(folder):
+        return []
+    findings = []
+    for name in sorted(os.listdir(folder)):
+        rel = "magnetics/" + name
+        rules = [(bad, why) for patterns, bad, why in LAYERS
+                 if any(fnmatch.fnmatchcase(rel, p) for p in patterns)]
+        if not rules:
+            continue
+        for number, inc in local_includes(root, rel):
+            for bad, why in rules:
+                chain = include_chain(root, inc, bad)
+                if chain:
+                    via = " (through %s)" % ", ".join(chain[:-1]) if len(chain) > 1 else ""
+                    findings.append("%s:%d: includes %s%s, the header above it: %s"
+                                    % (rel, number, chain[-1], via, why))
+    return findings
 
 
 def find_on_line(line):
@@ -88,7 +175,7 @@ def check(root, excluded):
             message = find_on_line(line)
             if message:
                 findings.append("%s:%d: %s" % (rel, number, message))
-    return findings
+    return findings + check_layers(root)
 
 
 def self_test():
@@ -128,11 +215,47 @@ def self_test():
         if message:
             print("self-test: flagged: %r: %s" % (line, message))
             ok = False
+    if not self_test_layers():
+        ok = False
     counts = {b"": 0, b"a\n": 1, b"a\nb": 2, b"a\nb\n": 2}
     for data, want in counts.items():
         if count_lines(data) != want:
             print("self-test: count_lines(%r) = %d, want %d" % (data, count_lines(data), want))
             ok = False
+    return ok
+
+
+def self_test_layers():
+    """check_layers on a small tree: the bad includes (one direct, one through a header) are
+    flagged, the allowed ones not; True when it behaves."""
+    tree = {
+        "magnetics/fields.hpp": '#include "magnetics/dipole_field.hpp"\n',
+        "magnetics/dipole_field.hpp": '#include "magnetics/source_buffer.hpp"\n',
+        "magnetics/source_buffer.hpp": "",
+        "magnetics/barnes_hut.cpp": '#include "magnetics/fields.hpp"\n',
+        "magnetics/magnetization.hpp": '#include "magnetics/magnetization_types.hpp"\n',
+        "magnetics/magnetization_types.hpp": '#include "magnetics/fields.hpp"\n',
+        "magnetics/magnetization.cpp": '#include "magnetics/anderson.hpp"\n',
+        "magnetics/anderson.hpp": '#include "magnetics/magnetization_types.hpp"\n',
+        "magnetics/anderson.cpp": '#include "magnetics/anderson.hpp"\n'
+                                  '#include "magnetics/forces.hpp"\n',
+        "magnetics/forces.hpp": '#include "magnetics/magnetization.hpp"\n',
+    }
+    want = ["magnetics/anderson.cpp:2: includes magnetics/magnetization.hpp (through "
+            "magnetics/forces.hpp)",
+            "magnetics/barnes_hut.cpp:1: includes magnetics/fields.hpp,"]
+    top = tempfile.mkdtemp(prefix="house_check_")
+    try:
+        for rel, text in tree.items():
+            os.makedirs(os.path.join(top, os.path.dirname(rel)), exist_ok=True)
+            with open(os.path.join(top, rel), "w") as f:
+                f.write(text)
+        got = check_layers(top)
+    finally:
+        shutil.rmtree(top)
+    ok = len(got) == len(want) and all(g.startswith(w) for g, w in zip(got, want))
+    if not ok:
+        print("self-test: layers found %r, want lines starting %r" % (got, want))
     return ok
 
 

@@ -90,7 +90,7 @@ def snapshot_speed_section(out, L):
         if direct and bh:
             L.append(f"Its fastest field evaluation takes {min(bh) / direct[0]:.2f}× the direct "
                      f"sum's time on these {j['snapshot']['moments']} moments (break-even: "
-                     "1,000–2,500 moments, dipole_field.hpp).")
+                     "1,000–2,500 moments, fields.hpp).")
         L.append("")
 
 

@@ -229,9 +229,9 @@ double zeeman_total_work_error(double dt) {
 }  // namespace
 
 TEST_CASE("energy: under zeeman-total the magnetic work is −ΔE_sys (its potential)", "[energy]") {
-  // zeeman-total is the gradient of E_sys (forces.hpp): the work done is −ΔE_sys up to the
-  // explicit step's error (force at the start of each step), which is O(h): refining the step
-  // 16× must take the mismatch toward zero
+  // zeeman-total is the gradient of E_sys (forces_total.hpp): the work done is −ΔE_sys up to
+  // the explicit step's error (force at the start of each step), which is O(h): refining the
+  // step 16× must take the mismatch toward zero
   const double e1 = zeeman_total_work_error(1e-3), e4 = zeeman_total_work_error(2.5e-4), e16 = zeeman_total_work_error(6.25e-5);
   INFO("W_mag/(−ΔE_sys) − 1: " << e1 << " at 1 ms, " << e4 << " at 0.25 ms, " << e16 << " at 0.0625 ms");
   // measured: −0.027, −0.0067, then smaller: first order, toward 0

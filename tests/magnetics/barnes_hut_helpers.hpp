@@ -4,7 +4,9 @@
 #pragma once
 
 #include "magnetics/barnes_hut.hpp"
+#include "magnetics/dipole_field.hpp"
 #include "magnetics/field_kernel.hpp"
+#include "magnetics/fields.hpp"
 #include "tests/magnetics/fixtures.hpp"
 
 #include <catch2/catch.hpp>

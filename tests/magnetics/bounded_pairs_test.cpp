@@ -4,6 +4,8 @@
 #include "magnetics/curves.hpp"
 #include "magnetics/dipole_field.hpp"
 #include "magnetics/field_kernel.hpp"
+#include "magnetics/fields.hpp"
+#include "magnetics/force_laws.hpp"
 #include "magnetics/forces.hpp"
 #include "tests/magnetics/fixtures.hpp"
 

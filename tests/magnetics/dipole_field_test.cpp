@@ -1,7 +1,9 @@
 // Tests for magnetics/dipole_field.cpp: eq. 1, its analytic Jacobian, the summed kernel
-// (AVX-512 and portable paths, cache chunks, determinism).
+// (AVX-512 and portable paths, cache chunks, determinism), run through compute_fields
+// (magnetics/fields.hpp).
 #include "magnetics/dipole_field.hpp"
 #include "magnetics/field_kernel.hpp"
+#include "magnetics/fields.hpp"
 #include "tests/magnetics/fixtures.hpp"
 
 #include <catch2/catch.hpp>

@@ -2,6 +2,8 @@
 // differences, the classic force (eqs. 13–14) against its closed form, Newton's third law.
 #include "magnetics/forces.hpp"
 #include "magnetics/curves.hpp"
+#include "magnetics/dipole_field.hpp"
+#include "magnetics/force_laws.hpp"
 #include "magnetics/ground_truth.hpp"
 #include "tests/magnetics/fixtures.hpp"
 

@@ -2,6 +2,7 @@
 // the negative gradient of E_sys with every magnetization re-solved (finite differences),
 // one moment in a fixed field gets eq. 4 exactly, and the forces sum to zero.
 #include "magnetics/forces.hpp"
+#include "magnetics/forces_total.hpp"
 #include "magnetics/ground_truth.hpp"
 #include "tests/magnetics/fixtures.hpp"
 

@@ -1,4 +1,6 @@
 // tools/experiments/fig10.cpp — Fig. 10: force magnitude near a uniformly magnetized sphere.
+#include "magnetics/dipole_field.hpp"
+#include "magnetics/force_laws.hpp"
 #include "tools/experiments/experiments.hpp"
 
 #include <algorithm>
