@@ -25,10 +25,10 @@ struct FieldFlags {
   void add(CLI::App* app, const std::string& solver_help) {
     solver_opt = app->add_option("--field-solver", solver, solver_help);
     theta_opt = app->add_option("--bh-theta", theta, "Barnes-Hut opening angle, in (0, 1]")
-                    ->check(OptionCheck("bh_theta"))
+                    ->check(OptionCheck("magnetics.field.bh_theta"))
                     ->capture_default_str();
     threshold_opt = app->add_option("--bh-threshold", threshold, "auto: moments from which Barnes-Hut is used")
-                        ->check(OptionCheck("bh_threshold"))
+                        ->check(OptionCheck("magnetics.field.auto_threshold"))
                         ->capture_default_str();
   }
   bool has_solver() const { return solver_opt && solver_opt->count() > 0; }

@@ -327,7 +327,7 @@ int main(int argc, char** argv) {
   app.add_option("--softening", a.softening,
                  "dipole softening length eps (m): |r|^2 -> |r|^2 + eps^2 in every field, Jacobian and "
                  "force, in [0, 0.1] (default: the scene's)")
-      ->check(tools::OptionCheck("magnetics.softening"));
+      ->check(tools::OptionCheck("magnetics.field.softening"));
   a.field.add(&app,
               mag::kFieldSolverNames.list(" | ") + ": how the dipole fields are summed, for the magnetization "
               "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
@@ -343,7 +343,7 @@ int main(int argc, char** argv) {
                                       "MemAvailable or what ulimit -v leaves, scene files that are not regular "
                                       "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
                                       std::string(tools::kMagsimKernelHelp) + "\n"
-                                      "Every option flag has the range of its scene-file key (scenes/option_ranges.hpp).\n"
+                                      "Every option flag has the range of its scene-file key (engine/options_table.cpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
                                       "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
                                       "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
