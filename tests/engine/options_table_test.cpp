@@ -1,7 +1,9 @@
 // tests/engine/options_table_test.cpp — the table of run options (engine/options_table.hpp):
 // each entry reaches its own member and no other, round-trips through the scene file's JSON
-// under its key and under its older one, has a range within mag::validate's, and
-// scenes/SCENE_FILE.md lists exactly the table's options with their keys, defaults and values.
+// under its key and under its older one, is checked by compile_model in the range the scene
+// file takes (which lies within mag::validate's), and scenes/SCENE_FILE.md lists exactly the
+// table's options with their keys, defaults and values.
+#include "engine/model.hpp"
 #include "engine/options_table.hpp"
 #include "scenes/options_json.hpp"
 #include "tests/engine/option_probes.hpp"
@@ -141,6 +143,25 @@ TEST_CASE("options table: magsolve's \"magnetics\" object reads the magnetics op
   CHECK(old.field.bounded_pairs);
   CHECK_THROWS_WITH(scenes::from_json(scenes::JsonReader("case.json"), json{{"bh_theta", 0.5}}, "magnetics", &old),
                     Catch::Matchers::Contains("case.json: magnetics.bh_theta: unknown key"));
+}
+
+TEST_CASE("options table: compile_model refuses each number just outside its range, naming options.<key>", "[options_table]") {
+  engine::SceneDesc scene;
+  REQUIRE_NOTHROW(engine::compile_model(scene));
+  for (const OptionSpec& s : engine::options_table()) {
+    if (s.kind != OptionKind::Number && s.kind != OptionKind::Integer) continue;
+    const engine::OptionRange& r = s.range;
+    std::vector<double> outside;
+    if (r.lo != -DBL_MAX) outside.push_back(r.integer ? r.lo - 1 : r.lo_open ? r.lo : std::nextafter(r.lo, -DBL_MAX));
+    if (r.hi != DBL_MAX) outside.push_back(r.integer ? r.hi + 1 : r.hi_open ? r.hi : std::nextafter(r.hi, DBL_MAX));
+    if (!r.integer) outside.push_back(std::nan(""));
+    for (const double x : outside) {
+      INFO("options." << s.key << " = " << x);
+      engine::SceneDesc bad = scene;
+      s.set(bad.options, x);
+      CHECK_THROWS_WITH(engine::compile_model(bad), Catch::Matchers::StartsWith("options." + s.key + ": must be"));
+    }
+  }
 }
 
 TEST_CASE("options table: the magnetics' ranges lie within the library's own (mag::validate)", "[options_table]") {
