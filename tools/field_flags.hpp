@@ -1,6 +1,7 @@
-// tools/field_flags.hpp — the dipole-field flags shared by magsim-scene and bench:
-// --field-solver (mag::kFieldSolverNames), --bh-theta θ, --bh-threshold N. Flags not given
-// leave the scene's FieldOptions as they are.
+// tools/field_flags.hpp — bench's dipole-field flags: --field-solver (mag::kFieldSolverNames),
+// --bh-theta θ, --bh-threshold N, in the ranges of their options (engine/options_table.hpp;
+// magsim-scene's flags of the same names come from that table). Flags not given leave the
+// scene's FieldOptions as they are.
 #pragma once
 
 #include "magnetics/dipole_field.hpp"
