@@ -6,6 +6,7 @@
 #include "engine/model.hpp"
 
 #include "engine/limits.hpp"
+#include "engine/options_table.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -55,57 +56,25 @@ std::string body_where(int i, const std::string& name) {
   return "body " + std::to_string(i) + " '" + name + "'";
 }
 
+// Each option in its range (engine/options_table.hpp: the scene file's, the flags'), then
+// what no single option's range says: the machine's thread cap and the combinations.
 void check_options(const SimOptions& o, const Vec3& H0) {
-  if (!(o.dt > 0 && o.dt <= 0.1)) fail("options.dt", "must be in (0, 0.1] s (got " + fmt(o.dt) + ")");
-  if (!finite(o.gravity)) fail("options.gravity", "must be finite (got " + fmt(o.gravity) + ")");
-  check_at_most("options.gravity", o.gravity.stableNorm(), limits::kMaxGravity, "m/s^2");
-  check_non_negative("options.friction", o.friction);
-  if (!(o.restitution >= 0 && o.restitution <= 1))
-    fail("options.restitution", "must be in [0, 1] (got " + fmt(o.restitution) + ")");
-  if (!(o.erp >= 0 && o.erp <= 1)) fail("options.erp", "must be in [0, 1] (got " + fmt(o.erp) + ")");
-  check_non_negative("options.cfm", o.cfm);
-  if (o.quickstep_iterations < 1)
-    fail("options.quickstep_iterations", "must be >= 1 (got " + std::to_string(o.quickstep_iterations) + ")");
-  if (!(o.quickstep_w > 0 && o.quickstep_w < 2))
-    fail("options.quickstep_w", "must be in (0, 2) (got " + fmt(o.quickstep_w) + ")");
-  if (o.max_contacts < 1 || o.max_contacts > 64)
-    fail("options.max_contacts", "must be in [1, 64] (got " + std::to_string(o.max_contacts) + ")");
-  check_non_negative("options.linear_damping", o.linear_damping);
-  check_non_negative("options.angular_damping", o.angular_damping);
-  check_non_negative("options.surface_layer", o.surface_layer);
-  if (!(o.max_correcting_velocity >= 0))
-    fail("options.max_correcting_velocity", "must be >= 0 (0 = unlimited) (got " + fmt(o.max_correcting_velocity) + ")");
-  if (!std::isfinite(o.contact_margin))
-    fail("options.contact_margin", "must be finite (< 0 = auto, 0 = off) (got " + fmt(o.contact_margin) + ")");
-  if (o.threads < 0) fail("options.threads", "must be >= 0 (got " + std::to_string(o.threads) + ")");
+  for (const OptionSpec& spec : options_table())
+    if (const std::string e = spec.error(spec.get(o)); !e.empty()) fail("options." + spec.key, e);
   // the same cap as magsim-scene --threads: more only slows the run, 1e5 crashes libgomp
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   if (o.threads > 4 * cores)
     fail("options.threads", "at most " + std::to_string(4 * cores) + " (4 x the " + std::to_string(cores) +
                                 " cores), got " + std::to_string(o.threads));
-  check_non_negative("options.rolling_friction", o.rolling_friction, "m");
-  check_non_negative("options.rolling_friction_bodies", o.rolling_friction_bodies, "m");
-  check_non_negative("options.eddy_conductivity", o.eddy_conductivity, "S/m");
-  if (o.max_substeps < 1 || o.max_substeps > 64)
-    fail("options.max_substeps", "must be in [1, 64] (got " + std::to_string(o.max_substeps) + ")");
-  if (!(o.substep_reach > 0 && std::isfinite(o.substep_reach)))
-    fail("options.substep_reach", "must be > 0 and finite (got " + fmt(o.substep_reach) + ")");
-  check_non_negative("options.energy_guard_tolerance", o.energy_guard_tolerance);
-  check_non_negative("options.energy_guard_floor", o.energy_guard_floor, "J");
-  if (o.energy_guard_max_substeps < 1 || o.energy_guard_max_substeps > 64)
-    fail("options.energy_guard_max_substeps",
-         "must be in [1, 64] (got " + std::to_string(o.energy_guard_max_substeps) + ")");
   if (o.balance_magnetic_torque && !o.reaction_symmetric_forces)
     fail("options.balance_magnetic_torque",
          "needs reaction_symmetric_forces (it removes the torque those forces leave)");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
-  const std::string e = mag::validate(o.magnetics);
-  if (!e.empty()) fail("options.magnetics", e);
   // the pair model is a correction of U*: only the classic force is its gradient
   if (o.magnetics.field.near_field.model == mag::NearField::Pair &&
       resolved_force_model(o) != mag::ForceModel::Classic)
-    fail("options.near_field", std::string("pair needs the classic force (the default's); method '") +
+    fail("options.magnetics.field.near_field.model", std::string("pair needs the classic force (the default's); method '") +
                                    mag::method_name(o.magnetics.method) + "' with force '" +
                                    mag::kForceModelNames.name(resolved_force_model(o)) +
                                    "' has no energy for it to correct");

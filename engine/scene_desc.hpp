@@ -79,10 +79,12 @@ inline const char* space_name(SpaceKind k) { return kSpaceNames.name(k); }
 /// Parses a broad-phase name; returns false (and leaves *out alone) on an unknown name.
 inline bool parse_space(const std::string& name, SpaceKind* out) { return kSpaceNames.parse(name, out); }
 
-/// Run options. Defaults are the engine's; each scene overrides what it needs.
+/// Run options. Defaults are the engine's; each scene overrides what it needs. Every member,
+/// and every member of DynamicsOptions and FieldOptions, is declared in the table of options
+/// (engine/options_table.cpp), under its path as the scene-file key.
 struct SimOptions {
   /// The magnetization solve: its method, Δt_m, β, tolerance, cap … The method (the scene
-  /// file's top-level "method") defaults to anderson: Anderson-accelerated M = f(H(M)) with
+  /// file's "magnetics.method") defaults to anderson: Anderson-accelerated M = f(H(M)) with
   /// the classic force converges every rigid (sub-)step and makes the force −∇U*
   /// (magnetics/coenergy.hpp), so passive scenes lose energy and come to rest. `ours` is the
   /// paper as printed (θ dynamics eqs. 8–11, eq. 4), whose force has no energy. Scenes stop

@@ -4,9 +4,9 @@
 // so magsolve (magnetics only) and the scene loader share it.
 #pragma once
 
+#include "engine/options_table.hpp"
 #include "magnetics/names.hpp"
 #include "render/frame.hpp"
-#include "scenes/option_ranges.hpp"
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -81,8 +81,8 @@ class JsonReader {
       fail(path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(x) + ")");
     return static_cast<int>(x);
   }
-  /// A run option in its one range (scenes/option_ranges.hpp): the flags check the same.
-  double option(const nlohmann::json& j, const std::string& path, const OptionRange& range) const {
+  /// A number option in its one range (engine/options_table.hpp): the flags check the same.
+  double option(const nlohmann::json& j, const std::string& path, const engine::OptionRange& range) const {
     if (range.integer && !j.is_number_integer()) fail(path, "must be an integer in " + range.text());
     const double x = number(j, path);
     if (const std::string e = range.error(x); !e.empty()) fail(path, e);

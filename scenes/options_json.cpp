@@ -1,181 +1,173 @@
-// scenes/options_json.cpp — SimOptions <-> JSON (scenes/options_json.hpp). The reader checks
-// each value's kind and range and names the JSON path of the first bad one; the writer
-// writes every field, so the two are each other's inverse (tests/engine/options_json_test.cpp).
+// scenes/options_json.cpp — SimOptions <-> JSON through the table of options
+// (engine/options_table.hpp). The reader refuses unknown keys first (naming the keys it
+// takes), then reads each option present by its kind, checked against its range, naming the
+// JSON path of the first bad one; the writer writes every option, so the two are each other's
+// inverse (tests/engine/options_table_test.cpp).
 #include "scenes/options_json.hpp"
 
-#include "engine/limits.hpp"
-#include "scenes/option_ranges.hpp"
-#include "magnetics/magnetization.hpp"
+#include "engine/options_table.hpp"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
 
 namespace magsim::scenes {
 
+using engine::OptionKind;
+using engine::OptionSpec;
+using engine::OptionValue;
 using engine::SimOptions;
+using engine::Vec3;
 using json = nlohmann::json;
 
-json to_json(const mag::DynamicsOptions& d) {
-  return json{{"dt", d.dt},
-              {"beta", d.beta},
-              {"alpha", d.alpha},
-              {"gamma_c_max", d.gamma_c_max},
-              {"adaptive_gamma_bound", d.adaptive_gamma_bound},
-              {"adaptive_gamma_cap", d.adaptive_gamma_cap},
-              {"tol", d.tol},
-              {"criterion", mag::kCriterionNames.name(d.criterion)},
-              {"max_iter", d.max_iter},
-              {"min_pair_angle", d.min_pair_angle},
-              {"theta_integrator", mag::kThetaIntegratorNames.name(d.theta_integrator)},
-              {"anderson_depth", d.anderson_depth},
-              {"anderson_damping", d.anderson_damping},
-              {"anderson_restart_growth", d.anderson_restart_growth},
-              {"softening", d.field.softening},
-              {"bounded_pairs", d.field.bounded_pairs}};
+namespace {
+
+std::vector<std::string> split(const std::string& path) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (std::size_t dot; (dot = path.find('.', start)) != std::string::npos; start = dot + 1)
+    parts.push_back(path.substr(start, dot - start));
+  parts.push_back(path.substr(start));
+  return parts;
 }
+
+// `key` relative to the object at `scope` ("" = the options object itself): "field.bh_theta"
+// for "magnetics.field.bh_theta" in "magnetics"; "" when the key is empty or lies outside it.
+std::string relative(const std::string& key, const std::string& scope) {
+  if (key.empty() || scope.empty()) return key;
+  return key.compare(0, scope.size() + 1, scope + ".") == 0 ? key.substr(scope.size() + 1) : std::string();
+}
+
+json value_json(const OptionSpec& s, const OptionValue& v) {
+  switch (s.kind) {
+    case OptionKind::Number: return std::get<double>(v);
+    case OptionKind::Integer: return static_cast<long long>(std::get<double>(v));
+    case OptionKind::Bool: return std::get<bool>(v);
+    case OptionKind::Name: return std::get<std::string>(v);
+    case OptionKind::Vector: return vec3_json(std::get<Vec3>(v));
+  }
+  return nullptr;
+}
+
+// The JSON kind first ("must be a number"), then the option's own check (range, names, length).
+OptionValue read_value(const JsonReader& r, const OptionSpec& s, const json& v, const std::string& p) {
+  OptionValue x;
+  switch (s.kind) {
+    case OptionKind::Number:
+    case OptionKind::Integer: return r.option(v, p, s.range);
+    case OptionKind::Bool: x = r.boolean(v, p); break;
+    case OptionKind::Name: x = r.string(v, p); break;
+    case OptionKind::Vector: x = r.vec3(v, p); break;
+  }
+  if (const std::string e = s.error(x); !e.empty()) r.fail(p, e);
+  return x;
+}
+
+// The value at the relative path `rel` of j, nullptr when absent. The objects on the way were
+// checked by check_keys.
+const json* find(const json& j, const std::string& rel) {
+  const json* at = &j;
+  for (const std::string& part : split(rel)) {
+    const auto it = at->find(part);
+    if (it == at->end()) return nullptr;
+    at = &*it;
+  }
+  return at;
+}
+
+// The keys of the options in scope, relative to it: each option's key and its older one.
+struct ScopeKeys {
+  std::vector<std::string> keys, old_keys;
+};
+
+// `obj` (at JSON path `path`, relative path `prefix`) holds only options and the objects on
+// the way to them ("magnetics", "field"), and "comment"; else the unknown key is named with
+// the keys its object takes.
+void check_keys(const JsonReader& r, const json& obj, const std::string& path, const std::string& prefix,
+                const ScopeKeys& scope) {
+  r.object(obj, path);
+  const std::string head = prefix.empty() ? "" : prefix + ".";
+  // the names one level below prefix; objects are those with a deeper key under them
+  auto children = [&](const std::vector<std::string>& keys, std::vector<std::string>* names,
+                      std::vector<std::string>* objects) {
+    for (const std::string& k : keys) {
+      if (k.compare(0, head.size(), head) != 0) continue;
+      const std::string rest = k.substr(head.size());
+      const std::size_t dot = rest.find('.');
+      const std::string name = rest.substr(0, dot);
+      bool seen = false;
+      for (const std::string& n : *names) seen = seen || n == name;
+      if (!seen) names->push_back(name);
+      if (dot != std::string::npos) objects->push_back(name);
+    }
+  };
+  std::vector<std::string> names, old_names, objects;
+  children(scope.keys, &names, &objects);
+  children(scope.old_keys, &old_names, &objects);
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    const std::string& k = it.key();
+    if (k == "comment") continue;
+    bool known = false, object = false;
+    for (const std::string& n : names) known = known || n == k;
+    for (const std::string& n : old_names) known = known || n == k;
+    for (const std::string& n : objects) object = object || n == k;
+    if (!known) {
+      std::string list, old_list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+      for (const std::string& n : old_names)
+        if (std::find(names.begin(), names.end(), n) == names.end()) old_list += (old_list.empty() ? "" : ", ") + n;
+      r.fail(JsonReader::join(path, k),
+             "unknown key (allowed: " + list + (old_list.empty() ? "" : "; older spellings: " + old_list) + ")");
+    }
+    if (object) check_keys(r, it.value(), JsonReader::join(path, k), head + k, scope);
+  }
+}
+
+// Reads the options under `scope` ("" = all of them, "magnetics" = options.magnetics) from the
+// object j at JSON path `path` into *o.
+void read_options(const JsonReader& r, const json& j, const std::string& path, const std::string& scope,
+                  SimOptions* o) {
+  ScopeKeys keys;
+  for (const OptionSpec& s : engine::options_table()) {
+    if (const std::string k = relative(s.key, scope); !k.empty()) keys.keys.push_back(k);
+    if (const std::string k = relative(s.old_key, scope); !k.empty()) keys.old_keys.push_back(k);
+  }
+  check_keys(r, j, path, "", keys);
+  for (const OptionSpec& s : engine::options_table()) {
+    const std::string key = relative(s.key, scope), old_key = relative(s.old_key, scope);
+    if (key.empty()) continue;
+    const json* now = find(j, key);
+    const json* before = old_key.empty() ? nullptr : find(j, old_key);
+    // one value per option: with both spellings, which one counts would be a guess
+    if (now && before)
+      r.fail(JsonReader::join(path, key),
+             "given twice: also as " + JsonReader::join(path, old_key) + ", its older spelling; keep one");
+    if (now) s.set(*o, read_value(r, s, *now, JsonReader::join(path, key)));
+    if (before) s.set(*o, read_value(r, s, *before, JsonReader::join(path, old_key)));
+  }
+}
+
+}  // namespace
 
 json to_json(const SimOptions& o) {
-  const mag::FieldOptions& f = o.magnetics.field;
-  return json{{"method", mag::method_name(o.magnetics.method)},
-              {"dt", o.dt},
-              {"gravity", vec3_json(o.gravity)},
-              {"ground", o.ground},
-              {"friction", o.friction},
-              {"restitution", o.restitution},
-              {"erp", o.erp},
-              {"cfm", o.cfm},
-              {"quickstep_iterations", o.quickstep_iterations},
-              {"quickstep_w", o.quickstep_w},
-              {"max_contacts", o.max_contacts},
-              {"space", engine::space_name(o.space)},
-              {"auto_disable", o.auto_disable},
-              {"linear_damping", o.linear_damping},
-              {"angular_damping", o.angular_damping},
-              {"surface_layer", o.surface_layer},
-              {"max_correcting_velocity", o.max_correcting_velocity},
-              {"contact_margin", o.contact_margin},
-              {"threads", o.threads},
-              {"reaction_symmetric_forces", o.reaction_symmetric_forces},
-              {"balance_magnetic_torque", o.balance_magnetic_torque},
-              {"force_model", mag::kForceModelNames.name(o.force_model)},
-              {"energy_guard", o.energy_guard},
-              {"energy_guard_tolerance", o.energy_guard_tolerance},
-              {"energy_guard_floor", o.energy_guard_floor},
-              {"energy_guard_max_substeps", o.energy_guard_max_substeps},
-              {"max_substeps", o.max_substeps},
-              {"substep_reach", o.substep_reach},
-              {"substep_load", o.substep_load},
-              {"rolling_friction", o.rolling_friction},
-              {"rolling_friction_bodies", o.rolling_friction_bodies},
-              {"eddy_conductivity", o.eddy_conductivity},
-              {"max_body_speed", o.max_body_speed},
-              {"field_solver", mag::field_solver_name(f.solver)},
-              {"bh_theta", f.bh_theta},
-              {"bh_threshold", f.auto_threshold},
-              {"bh_leaf_size", f.bh_leaf_size},
-              {"bh_group_size", f.bh_group_size},
-              {"bh_order", f.bh_order},
-              {"bh_near_float", f.bh_near_float},
-              {"bh_far_float", f.bh_far_float},
-              {"near_field", mag::kNearFieldNames.name(f.near_field.model)},
-              {"near_field_mu_r", f.near_field.mu_r},
-              {"magnetics", to_json(o.magnetics)}};
-}
-
-void from_json(const JsonReader& r, const json& j, const std::string& path, mag::DynamicsOptions* d) {
-  r.keys(j, path, {"dt", "beta", "alpha", "gamma_c_max", "adaptive_gamma_bound", "adaptive_gamma_cap",
-                   "tol", "criterion", "max_iter", "min_pair_angle", "theta_integrator", "softening",
-                   "bounded_pairs", "anderson_depth", "anderson_damping", "anderson_restart_growth"});
-  if_present(j, "dt", path, [&](const json& v, const std::string& p) { d->dt = r.option(v, p, option_range("magnetics.dt")); });
-  if_present(j, "beta", path, [&](const json& v, const std::string& p) { d->beta = r.positive(v, p); });
-  if_present(j, "alpha", path, [&](const json& v, const std::string& p) { d->alpha = r.in_range(v, p, 1e-12, 1.0); });
-  if_present(j, "gamma_c_max", path, [&](const json& v, const std::string& p) { d->gamma_c_max = r.in_range(v, p, 1.0 / 3.0, 1e12); });
-  if_present(j, "adaptive_gamma_bound", path, [&](const json& v, const std::string& p) { d->adaptive_gamma_bound = r.boolean(v, p); });
-  if_present(j, "adaptive_gamma_cap", path, [&](const json& v, const std::string& p) { d->adaptive_gamma_cap = r.positive(v, p); });
-  if_present(j, "tol", path, [&](const json& v, const std::string& p) { d->tol = r.option(v, p, option_range("magnetics.tol")); });
-  if_present(j, "max_iter", path, [&](const json& v, const std::string& p) { d->max_iter = static_cast<int>(r.option(v, p, option_range("magnetics.max_iter"))); });
-  if_present(j, "min_pair_angle", path, [&](const json& v, const std::string& p) { d->min_pair_angle = r.in_range(v, p, 1e-300, 0.0099999); });
-  if_present(j, "theta_integrator", path, [&](const json& v, const std::string& p) {
-    d->theta_integrator = r.named(v, p, mag::kThetaIntegratorNames, "theta integrator");
-  });
-  if_present(j, "criterion", path, [&](const json& v, const std::string& p) {
-    d->criterion = r.named(v, p, mag::kCriterionNames, "criterion");
-  });
-  if_present(j, "softening", path, [&](const json& v, const std::string& p) { d->field.softening = r.option(v, p, option_range("magnetics.softening")); });
-  if_present(j, "bounded_pairs", path, [&](const json& v, const std::string& p) { d->field.bounded_pairs = r.boolean(v, p); });
-  if_present(j, "anderson_depth", path, [&](const json& v, const std::string& p) { d->anderson_depth = r.integer(v, p, 0, 50); });
-  if_present(j, "anderson_damping", path, [&](const json& v, const std::string& p) { d->anderson_damping = r.in_range(v, p, 1e-300, 1.0); });
-  if_present(j, "anderson_restart_growth", path, [&](const json& v, const std::string& p) { d->anderson_restart_growth = r.positive(v, p); });
-  const std::string e = mag::validate(*d);
-  if (!e.empty()) r.fail(path, e);
+  json j = json::object();
+  for (const OptionSpec& s : engine::options_table()) {
+    json* at = &j;
+    for (const std::string& part : split(s.key)) at = &(*at)[part];
+    *at = value_json(s, s.get(o));
+  }
+  return j;
 }
 
 void from_json(const JsonReader& r, const json& j, const std::string& path, SimOptions* o) {
-  r.keys(j, path, {"method", "dt", "gravity", "ground", "friction", "restitution", "erp", "cfm",
-                   "quickstep_iterations", "max_contacts", "space", "auto_disable", "linear_damping",
-                   "angular_damping", "surface_layer", "max_correcting_velocity", "contact_margin",
-                   "threads", "reaction_symmetric_forces", "balance_magnetic_torque", "field_solver",
-                   "bh_theta", "bh_threshold", "magnetics", "force_model", "max_substeps", "substep_reach",
-                   "substep_load", "rolling_friction", "rolling_friction_bodies", "eddy_conductivity",
-                   "quickstep_w", "max_body_speed", "bh_leaf_size", "bh_group_size", "bh_order",
-                   "bh_near_float", "bh_far_float", "near_field", "near_field_mu_r", "energy_guard", "energy_guard_tolerance",
-                   "energy_guard_floor", "energy_guard_max_substeps"});
-  if_present(j, "method", path, [&](const json& v, const std::string& p) { o->magnetics.method = r.named(v, p, mag::kMethodNames, "method"); });
-  if_present(j, "dt", path, [&](const json& v, const std::string& p) {
-    o->dt = r.option(v, p, option_range("dt"));
-  });
-  if_present(j, "gravity", path, [&](const json& v, const std::string& p) { o->gravity = r.bounded(v, p, engine::limits::kMaxGravity, "m/s^2"); });
-  if_present(j, "ground", path, [&](const json& v, const std::string& p) { o->ground = r.boolean(v, p); });
-  if_present(j, "friction", path, [&](const json& v, const std::string& p) { o->friction = r.non_negative(v, p); });
-  if_present(j, "restitution", path, [&](const json& v, const std::string& p) { o->restitution = r.in_range(v, p, 0, 1); });
-  if_present(j, "erp", path, [&](const json& v, const std::string& p) { o->erp = r.in_range(v, p, 0, 1); });
-  if_present(j, "cfm", path, [&](const json& v, const std::string& p) { o->cfm = r.non_negative(v, p); });
-  if_present(j, "quickstep_iterations", path, [&](const json& v, const std::string& p) { o->quickstep_iterations = static_cast<int>(r.option(v, p, option_range("quickstep_iterations"))); });
-  if_present(j, "max_contacts", path, [&](const json& v, const std::string& p) { o->max_contacts = r.integer(v, p, 1, 64); });
-  if_present(j, "space", path, [&](const json& v, const std::string& p) { o->space = r.named(v, p, engine::kSpaceNames, "space"); });
-  if_present(j, "auto_disable", path, [&](const json& v, const std::string& p) { o->auto_disable = r.boolean(v, p); });
-  if_present(j, "linear_damping", path, [&](const json& v, const std::string& p) { o->linear_damping = r.non_negative(v, p); });
-  if_present(j, "angular_damping", path, [&](const json& v, const std::string& p) { o->angular_damping = r.non_negative(v, p); });
-  if_present(j, "surface_layer", path, [&](const json& v, const std::string& p) { o->surface_layer = r.non_negative(v, p); });
-  if_present(j, "max_correcting_velocity", path, [&](const json& v, const std::string& p) { o->max_correcting_velocity = r.non_negative(v, p); });
-  if_present(j, "contact_margin", path, [&](const json& v, const std::string& p) { o->contact_margin = r.number(v, p); });
-  if_present(j, "threads", path, [&](const json& v, const std::string& p) { o->threads = static_cast<int>(r.option(v, p, option_range("threads"))); });
-  if_present(j, "force_model", path, [&](const json& v, const std::string& p) {
-    o->force_model = r.named(v, p, mag::kForceModelNames, "force model");
-  });
-  if_present(j, "energy_guard", path, [&](const json& v, const std::string& p) { o->energy_guard = r.boolean(v, p); });
-  if_present(j, "energy_guard_tolerance", path, [&](const json& v, const std::string& p) { o->energy_guard_tolerance = r.option(v, p, option_range("energy_guard_tolerance")); });
-  if_present(j, "energy_guard_floor", path, [&](const json& v, const std::string& p) { o->energy_guard_floor = r.option(v, p, option_range("energy_guard_floor")); });
-  if_present(j, "energy_guard_max_substeps", path, [&](const json& v, const std::string& p) { o->energy_guard_max_substeps = static_cast<int>(r.option(v, p, option_range("energy_guard_max_substeps"))); });
-  if_present(j, "max_substeps", path, [&](const json& v, const std::string& p) { o->max_substeps = static_cast<int>(r.option(v, p, option_range("max_substeps"))); });
-  if_present(j, "substep_reach", path, [&](const json& v, const std::string& p) { o->substep_reach = r.option(v, p, option_range("substep_reach")); });
-  if_present(j, "substep_load", path, [&](const json& v, const std::string& p) { o->substep_load = r.boolean(v, p); });
-  if_present(j, "rolling_friction", path, [&](const json& v, const std::string& p) { o->rolling_friction = r.option(v, p, option_range("rolling_friction")); });
-  if_present(j, "rolling_friction_bodies", path,
-             [&](const json& v, const std::string& p) { o->rolling_friction_bodies = r.option(v, p, option_range("rolling_friction_bodies")); });
-  if_present(j, "eddy_conductivity", path,
-             [&](const json& v, const std::string& p) { o->eddy_conductivity = r.option(v, p, option_range("eddy_conductivity")); });
-  if_present(j, "quickstep_w", path, [&](const json& v, const std::string& p) {
-    o->quickstep_w = r.option(v, p, option_range("quickstep_w"));
-  });
-  if_present(j, "reaction_symmetric_forces", path, [&](const json& v, const std::string& p) { o->reaction_symmetric_forces = r.boolean(v, p); });
-  if_present(j, "balance_magnetic_torque", path, [&](const json& v, const std::string& p) { o->balance_magnetic_torque = r.boolean(v, p); });
-  mag::FieldOptions& f = o->magnetics.field;
-  if_present(j, "field_solver", path, [&](const json& v, const std::string& p) {
-    f.solver = r.named(v, p, mag::kFieldSolverNames, "field solver");
-  });
-  if_present(j, "bh_theta", path, [&](const json& v, const std::string& p) {
-    f.bh_theta = r.option(v, p, option_range("bh_theta"));
-  });
-  if_present(j, "bh_threshold", path, [&](const json& v, const std::string& p) { f.auto_threshold = static_cast<int>(r.option(v, p, option_range("bh_threshold"))); });
-  if_present(j, "bh_leaf_size", path, [&](const json& v, const std::string& p) { f.bh_leaf_size = r.integer(v, p, 1, 1000000); });
-  if_present(j, "bh_group_size", path, [&](const json& v, const std::string& p) { f.bh_group_size = r.integer(v, p, 1, 1000000); });
-  if_present(j, "bh_order", path, [&](const json& v, const std::string& p) { f.bh_order = r.integer(v, p, 1, 2); });
-  if_present(j, "bh_near_float", path, [&](const json& v, const std::string& p) { f.bh_near_float = r.boolean(v, p); });
-  if_present(j, "bh_far_float", path, [&](const json& v, const std::string& p) { f.bh_far_float = r.boolean(v, p); });
-  if_present(j, "near_field", path, [&](const json& v, const std::string& p) {
-    f.near_field.model = r.named(v, p, mag::kNearFieldNames, "near-field model");
-  });
-  if_present(j, "near_field_mu_r", path, [&](const json& v, const std::string& p) { f.near_field.mu_r = r.in_range(v, p, 10.0, 10000.0); });
-  if_present(j, "max_body_speed", path, [&](const json& v, const std::string& p) { o->max_body_speed = r.non_negative(v, p); });
-  if_present(j, "magnetics", path, [&](const json& v, const std::string& p) { from_json(r, v, p, &o->magnetics); });
+  read_options(r, j, path, "", o);
+}
+
+void from_json(const JsonReader& r, const json& j, const std::string& path, mag::DynamicsOptions* d) {
+  SimOptions o;
+  o.magnetics = *d;
+  read_options(r, j, path, "magnetics", &o);
+  *d = o.magnetics;
 }
 
 }  // namespace magsim::scenes

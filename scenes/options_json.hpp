@@ -1,8 +1,11 @@
 // scenes/options_json.hpp — the run options (SimOptions, with its mag::DynamicsOptions and
 // mag::FieldOptions) as JSON, one spelling for everything that reads or writes them: the
 // scene file's "options" object (SCENE_FILE.md), summary.json's "options", --write-scene and
-// magsolve's case "magnetics". to_json writes every field; from_json reads them back, so
-// from_json(to_json(o)) == o, and a summary's options replayed as a scene file rerun the run.
+// magsolve's case "magnetics". Both go through the table of options (engine/options_table.hpp):
+// the layout is the structs' ("magnetics": {"field": {"bh_theta": …}}), to_json writes every
+// option, from_json reads them back, so from_json(to_json(o)) == o, and a summary's options
+// replayed as a scene file rerun the run. from_json also reads the keys of files written before
+// the layout followed the structs ("bh_theta" for "magnetics.field.bh_theta").
 #pragma once
 
 #include "engine/scene_desc.hpp"
@@ -11,21 +14,17 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
-#include <vector>
 
 namespace magsim::scenes {
 
-/// Every SimOptions field under its scene-file name ("dt", "space", "magnetics": {…}, …).
+/// Every option under its key, nested as the structs are ("dt", "space", "magnetics": {…}).
 nlohmann::json to_json(const engine::SimOptions& o);
-/// The "magnetics" object: every DynamicsOptions field but the method (the options' top-level
-/// "method" holds it), with FieldOptions' softening and bounded_pairs (the other field options sit
-/// beside it in "options": field_solver, bh_theta, bh_threshold, bh_*).
-nlohmann::json to_json(const mag::DynamicsOptions& d);
 
-/// Reads the keys present in `j` (an "options" object at `path`) into *o, checked; keys
-/// absent keep *o's values. Throws std::runtime_error via r (unknown key, bad value).
+/// Reads the keys present in `j` (an "options" object at `path`) into *o, each checked against
+/// its entry in the table; keys absent keep *o's values. Throws std::runtime_error via r: an
+/// unknown key, a bad value, or an option given under both its key and its older one.
 void from_json(const JsonReader& r, const nlohmann::json& j, const std::string& path, engine::SimOptions* o);
-/// The same for a "magnetics" object (the method is left alone).
+/// The same for a "magnetics" object (a scene file's options.magnetics: method, field, …).
 void from_json(const JsonReader& r, const nlohmann::json& j, const std::string& path, mag::DynamicsOptions* d);
 
 /// [x, y, z]: how scene files, summary.json and the options write a vector.

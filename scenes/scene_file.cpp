@@ -12,29 +12,8 @@
 //     "H0": [0, 0, 0],                          // uniform external field (A/m)
 //     "camera": {"eye": [x,y,z], "target": [x,y,z], "up": [x,y,z],
 //                "fov_y_deg": 40, "z_near": 0, "z_far": 0},
-//     "options": {                              // scenes/options_json.cpp; every key:
-//       "method": "ours-realigned" | "ours" | "kim2018" | "damping-llg" | "anderson" | "exact",
-//       "dt": 1e-3, "gravity": [0,0,-9.81], "ground": true, "friction": 0.5,
-//       "restitution": 0, "erp": 0.2, "cfm": 1e-9, "quickstep_iterations": 20,
-//       "max_contacts": 4, "space": "sap" | "hash" | "simple", "auto_disable": false,
-//       "linear_damping": 0, "angular_damping": 0, "surface_layer": 0,
-//       "max_correcting_velocity": 0, "contact_margin": -1, "threads": 0,
-//       "reaction_symmetric_forces": false, "balance_magnetic_torque": false,
-//       "force_model": "method" | "zeeman" | "classic" | "zeeman-total",
-//       "max_substeps": 1,
-//       "substep_reach": 0.25, "rolling_friction": 0, "quickstep_w": 1.3,
-//       "field_solver": "direct" | "barnes-hut" | "auto", "bh_theta": 0.3,  // (0, 1]
-//       "bh_threshold": 2000,                   // auto: Barnes–Hut from this many moments
-//       "bh_leaf_size": 64, "bh_group_size": 32, "bh_order": 2,
-//       "bh_near_float": true, "bh_far_float": true,
-//       "max_body_speed": 1000,                 // blow-up guard (m/s), 0 = off
-//       "magnetics": {"dt": 1e-7, "beta": 5, "alpha": 0.2, "gamma_c_max": 1,
-//                     "adaptive_gamma_bound": true, "adaptive_gamma_cap": 2.5,
-//                     "tol": 1e-4, "criterion": "residual" | "change", "max_iter": 100,
-//                     "min_pair_angle": 1e-6, "theta_integrator": "exact" | "euler",
-//                     "anderson_depth": 5, "anderson_damping": 1,
-//                     "anderson_restart_growth": 2, "softening": 0, "bounded_pairs": false}
-//     },
+//     "options": {"dt": 1e-3, "magnetics": {"method": "anderson", "field": {…}}, …},
+//                  // every run option: engine/options_table.cpp (SCENE_FILE.md lists them)
 //     "bodies": [                               // required
 //       {"name": "ball_0", "type": "dynamic" | "kinematic" | "static",
 //        "position": [x,y,z], "orientation": [w,x,y,z],

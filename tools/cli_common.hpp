@@ -4,7 +4,7 @@
 // --threads and OMP_NUM_THREADS alike, and the signal dispositions of both programs.
 #pragma once
 
-#include "scenes/option_ranges.hpp"
+#include "engine/options_table.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -180,10 +180,9 @@ CLI::Validator Range(T lo, T hi) {
   }
 }
 
-/// The flag of a run option: its one range (scenes/option_ranges.hpp), the scene file's too.
-/// An integer option takes decimal digits only (decimal_error).
-inline CLI::Validator OptionCheck(const char* key) {
-  const scenes::OptionRange& r = scenes::option_range(key);
+/// The flag of a number option: its one range (engine/options_table.hpp), the scene file's
+/// too. An integer option takes decimal digits only (decimal_error).
+inline CLI::Validator OptionCheck(const engine::OptionRange& r) {
   return CLI::Validator(
       [r](std::string& v) -> std::string {
         const std::string bad = "must be " + r.what() + ", got '" + one_line(v) + "'";
@@ -203,6 +202,8 @@ inline CLI::Validator OptionCheck(const char* key) {
       },
       r.text());
 }
+/// The same for the option at `key` (an engine::options_table() key).
+inline CLI::Validator OptionCheck(const char* key) { return OptionCheck(engine::option_spec(key).range); }
 
 /// A number > 0 (CLI::PositiveNumber with a one-line message).
 inline const CLI::Validator PositiveNumber(

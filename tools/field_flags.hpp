@@ -1,7 +1,7 @@
-// tools/field_flags.hpp — the dipole-field flags shared by magsim-scene and bench:
-// --field-solver (mag::kFieldSolverNames), --bh-theta θ, --bh-threshold N, --near-field
-// (mag::kNearFieldNames), --near-field-mu-r μr. Flags not given leave the scene's FieldOptions
-// as they are.
+// tools/field_flags.hpp — bench's dipole-field flags: --field-solver (mag::kFieldSolverNames),
+// --bh-theta θ, --bh-threshold N, --near-field (mag::kNearFieldNames), --near-field-mu-r μr, in
+// the ranges of their options (engine/options_table.hpp; magsim-scene's flags of the same
+// names come from that table). Flags not given leave the scene's FieldOptions as they are.
 #pragma once
 
 #include "magnetics/fields.hpp"
@@ -30,10 +30,10 @@ struct FieldFlags {
   void add(CLI::App* app, const std::string& solver_help) {
     solver_opt = app->add_option("--field-solver", solver, solver_help);
     theta_opt = app->add_option("--bh-theta", theta, "Barnes-Hut opening angle, in (0, 1]")
-                    ->check(OptionCheck("bh_theta"))
+                    ->check(OptionCheck("magnetics.field.bh_theta"))
                     ->capture_default_str();
     threshold_opt = app->add_option("--bh-threshold", threshold, "auto: moments from which Barnes-Hut is used")
-                        ->check(OptionCheck("bh_threshold"))
+                        ->check(OptionCheck("magnetics.field.auto_threshold"))
                         ->capture_default_str();
     near_opt = app->add_option("--near-field", near_field,
                                "near field of touching iron balls: " + mag::kNearFieldNames.list("|") +

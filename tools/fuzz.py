@@ -385,13 +385,21 @@ def fam_concurrent(rng, out, timeout):
 
 
 def option_table():
-    """scenes/option_ranges.hpp's kOptionRanges: (key, flag, integer, lo, hi, lo_open, hi_open)."""
-    text = open(os.path.join(ROOT, "scenes/option_ranges.hpp")).read()
+    """The number options that have a flag: (key, flag, integer, lo, hi, lo_open, hi_open), from
+    scenes/SCENE_FILE.md's options table, which tests/engine/options_table_test.cpp holds to
+    the table in engine/options_table.cpp."""
+    text = open(os.path.join(ROOT, "scenes/SCENE_FILE.md")).read()
     rows = []
-    num = lambda t: sys.float_info.max if t.strip() == "DBL_MAX" else float(t)
-    for m in re.finditer(r'\{"([a-z_.]+)", "(--[a-z-]+)", (true|false), ([^,]+), ([^,]+), (true|false), (true|false),', text):
-        rows.append((m.group(1), m.group(2), m.group(3) == "true", num(m.group(4)), num(m.group(5)),
-                     m.group(6) == "true", m.group(7) == "true"))
+    num = lambda t: float(t)
+    row = re.compile(r"^\| `([a-z_.]+)` \| [^|]* \| an? (integer|number) (.*?) \| `(--[a-z-]+)` \|", re.M)
+    for m in row.finditer(text):
+        key, integer, values, flag = m.group(1), m.group(2) == "integer", m.group(3), m.group(4)
+        b = re.fullmatch(r"in ([\[(])([^,]+), ([^\])]+)([\])])", values)
+        h = re.fullmatch(r"(>=|>) (\S+) and finite", values)
+        if b:
+            rows.append((key, flag, integer, num(b.group(2)), num(b.group(3)), b.group(1) == "(", b.group(4) == ")"))
+        elif h:
+            rows.append((key, flag, integer, num(h.group(2)), sys.float_info.max, h.group(1) == ">", False))
     return rows
 
 
@@ -423,11 +431,9 @@ def fam_round_trip(rng, out, timeout):
     by_flag = scene([TWO_BALLS, flag, text, "--write-scene", written])
     j = json.load(open(base))
     at = j["options"]
-    if "." in key:
-        head, key_leaf = key.split(".")
-        at = at[head]
-    else:
-        key_leaf = key
+    *heads, key_leaf = key.split(".")  # "magnetics.field.bh_theta": down the objects
+    for head in heads:
+        at = at.setdefault(head, {})
     at[key_leaf] = int(v) if integer else float(v)
     with open(infile, "w") as f:
         json.dump(j, f)
@@ -439,7 +445,7 @@ def fam_round_trip(rng, out, timeout):
     if by_flag == 0 and scene([written, "--write-scene", back]) != 0:
         return f"{flag} {text}: the scene file --write-scene wrote is refused"
     # a short run with it, its summary's options pasted into a scene file, run again
-    if by_flag != 0 or (integer and v > 1000 and key != "bh_threshold") or rng.random() < 0.5:
+    if by_flag != 0 or (integer and v > 1000 and key != "magnetics.field.auto_threshold") or rng.random() < 0.5:
         return None
     runs = [os.path.join(d, "rt_run1"), os.path.join(d, "rt_run2")]
     for r in runs:
@@ -483,7 +489,7 @@ def main():
     SCENE, SOLVE = os.path.join(a.bin, "magsim-scene"), os.path.join(a.bin, "magsolve")
     OPTIONS.extend(option_table())
     if not OPTIONS:
-        sys.exit("fuzz.py: no options found in scenes/option_ranges.hpp")
+        sys.exit("fuzz.py: no options found in scenes/SCENE_FILE.md")
     if not (a.seconds > 0 and a.count > 0 and a.timeout > 0):
         ap.error("--seconds, --count and --timeout must be > 0")
     for b in (SCENE, SOLVE):

@@ -168,7 +168,7 @@ int run(int argc, char** argv) {
   app.add_option("--softening", softening,
                  "softening length ε in metres (0 = off; needed for two moments closer than half "
                  "the sum of their radii, a = the radius of a sphere of the moment's volume), in [0, 0.1]")
-      ->check(magsim::tools::OptionCheck("magnetics.softening"))->capture_default_str();
+      ->check(magsim::tools::OptionCheck("magnetics.field.softening"))->capture_default_str();
   app.add_option("--residual-tol", residual_tol,
                  "\"converged\" needs the iteration to stop (--tol) and every induced moment's "
                  "|M - f(H)| <= this x max(|M|, |f(H)|)")
@@ -238,6 +238,7 @@ int run(int argc, char** argv) {
     r.keys(doc, "", {"external_field", "moments", "magnetics"});
     if (doc.contains("magnetics")) magsim::scenes::from_json(r, doc["magnetics"], "magnetics", &opt);
     // flags given on the command line override the case's "magnetics"
+    if (app.count("--method")) mag::parse_method(method_name, &opt.method);  // a valid name: checked above
     if (app.count("--dt")) opt.dt = dt;
     if (app.count("--tol")) opt.tol = tol;
     if (app.count("--max-iter")) opt.max_iter = max_iter;

@@ -2,7 +2,7 @@
 // option shared by flag and scene file (and summary.json's options accepted back), the
 // memory a --count needs, and scene files parsed in linear time.
 #include "tests/tools/reliability.hpp"
-#include "scenes/option_ranges.hpp"
+#include "engine/options_table.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -31,7 +31,10 @@ TEST_CASE("one range per option: each flag and its scene-file key accept and ref
   const nlohmann::json scene_json = nlohmann::json::parse(text_of(base));
   const double cores = std::max(1u, std::thread::hardware_concurrency());
   std::size_t checked = 0;
-  for (const magsim::scenes::OptionRange& r : magsim::scenes::kOptionRanges) {
+  for (const magsim::engine::OptionSpec& spec : magsim::engine::options_table()) {
+    const bool number = spec.kind == magsim::engine::OptionKind::Number || spec.kind == magsim::engine::OptionKind::Integer;
+    if (spec.flag.empty() || !number) continue;
+    const magsim::engine::OptionRange& r = spec.range;
     std::vector<double> values;
     const double step = r.integer ? 1.0 : 0.0;
     auto below = [&](double x) { return r.integer ? x - step : std::nextafter(x, -DBL_MAX); };
@@ -40,20 +43,19 @@ TEST_CASE("one range per option: each flag and its scene-file key accept and ref
     if (r.hi != DBL_MAX) values.insert(values.end(), {r.hi, below(r.hi), above(r.hi)});
     for (const double v : values) {
       // the machine's cap on threads holds for flag and file alike
-      const bool want = r.contains(v) && !(std::string(r.key) == "threads" && v > 4 * cores);
+      const bool want = r.contains(v) && !(spec.key == "threads" && v > 4 * cores);
       const std::string text = r.integer ? std::to_string(static_cast<long long>(v)) : g17(v);
-      const int flag = scene_exit(two_balls + " " + r.flag + " " + text + " --write-scene " + written);
+      const int flag = scene_exit(two_balls + " " + spec.flag + " " + text + " --write-scene " + written);
       nlohmann::json j = scene_json;
       nlohmann::json* at = &j["options"];
-      const std::string key = r.key;
-      const std::size_t dot = key.find('.');
-      if (dot != std::string::npos) at = &(*at)[key.substr(0, dot)];
-      const std::string leaf = dot == std::string::npos ? key : key.substr(dot + 1);
-      if (r.integer) (*at)[leaf] = static_cast<long long>(v);
-      else (*at)[leaf] = v;
+      std::string key = spec.key;  // "magnetics.field.bh_theta": down the objects to the leaf
+      for (std::size_t dot; (dot = key.find('.')) != std::string::npos; key.erase(0, dot + 1))
+        at = &(*at)[key.substr(0, dot)];
+      if (r.integer) (*at)[key] = static_cast<long long>(v);
+      else (*at)[key] = v;
       write_text(file, j.dump(1));
       const int from_file = scene_exit(file + " --write-scene " + reread);
-      INFO(r.flag << " " << text << " / options." << r.key << ": flag exit " << flag << ", file exit " << from_file
+      INFO(spec.flag << " " << text << " / options." << spec.key << ": flag exit " << flag << ", file exit " << from_file
                   << ", range " << r.text());
       CHECK(flag == (want ? 0 : 1));
       CHECK(from_file == (want ? 0 : 1));

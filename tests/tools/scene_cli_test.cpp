@@ -75,7 +75,7 @@ TEST_CASE("magsim-scene: --force-model zeeman-total and --softening reach the ru
   REQUIRE(f.good());
   const auto j = nlohmann::json::parse(f);
   CHECK(j["options"]["force_model"] == "zeeman-total");
-  CHECK(j["options"]["magnetics"]["softening"] == 0.002);
+  CHECK(j["options"]["magnetics"]["field"]["softening"] == 0.002);
 }
 
 TEST_CASE("magsim-scene: the default broad phase is sweep and prune", "[tools]") {
@@ -128,7 +128,7 @@ TEST_CASE("magsim-scene: summary.json's options, replayed as a scene file's, rep
   std::ifstream f(out + "/summary.json");
   const auto summary = nlohmann::json::parse(f);
   CHECK(summary["options"]["magnetics"]["dt"] == 8e-8);
-  CHECK(summary["options"]["method"] == "anderson");
+  CHECK(summary["options"]["magnetics"]["method"] == "anderson");
   CHECK(summary["options"]["substep_load"] == false);
   CHECK(summary["options"]["rolling_friction_bodies"] == 2e-4);
   CHECK(summary["options"]["eddy_conductivity"] == 5e6);

@@ -6,7 +6,7 @@
 
 #include "engine/scene_desc.hpp"
 #include "tools/cli_common.hpp"
-#include "tools/field_flags.hpp"
+#include "tools/option_flags.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -41,7 +41,6 @@ struct IoError : std::runtime_error {
 
 struct Args {
   std::string scene;
-  std::string method;
   double seconds = 0.0;
   long steps = 0;
   std::string out;
@@ -49,32 +48,10 @@ struct Args {
   bool no_render = false;
   bool arrows = false;
   int width = 1280, height = 720, samples = 1;
-  int threads = 0;
   int count = 0;
   double strength = 0.0;
-  double dt_m = 0.0;
-  double tol = 0.0;
-  int max_iter = 0;
-  int quickstep_iterations = 0;
-  std::string space;
-  bool auto_disable = false;
-  std::string force_model;
-  int max_substeps = 0;
-  double substep_reach = 0.0;
-  std::string substep_load;
-  std::string balance_magnetic_torque;
-  double rolling_friction = 0.0;
-  double rolling_friction_bodies = 0.0;
-  double eddy_conductivity = 0.0;
-  std::string energy_guard;
-  double energy_guard_tolerance = 0.0;
-  double energy_guard_floor = 0.0;
-  int energy_guard_max_substeps = 0;
-  double quickstep_w = 0.0;
-  double dt = 0.0;
-  std::string bounded_pairs;
-  double softening = -1.0;
-  tools::FieldFlags field;
+  /// the flags of the run options (--method, --dt, --threads, …): engine/options_table.hpp
+  tools::OptionFlags options;
   bool list = false;
   std::string write_scene;
 };

@@ -106,13 +106,6 @@ namespace {
 // registry scenes above this --count are sized from builds of 1 and of this many first
 constexpr int kSampleCount = 100;
 
-// the value of an on | off flag
-bool on_off(const char* flag, const std::string& value) {
-  if (value != "on" && value != "off")
-    throw UsageError(std::string(flag) + ": expected on or off, got '" + value + "'");
-  return value == "on";
-}
-
 }  // namespace
 
 // The scene named on the command line, with the command line's overrides applied.
@@ -156,52 +149,18 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     }
     s = e->build(p);
   }
-  if (app.count("--method") && !mag::parse_method(a.method, &s.options.magnetics.method))
-    throw UsageError("--method: " + mag::kMethodNames.unknown("method", a.method));
-  // the thread cap holds for the flag and the scene file alike (--write-scene too)
-  const std::string cap = "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
-                          std::to_string(tools::max_threads() / 4) + " cores), got ";
-  if (app.count("--threads")) {
-    if (a.threads > tools::max_threads()) throw UsageError("--threads: " + cap + std::to_string(a.threads));
-    s.options.threads = a.threads;
-  } else if (s.options.threads > tools::max_threads()) {
-    throw UsageError(a.scene + ": options.threads: " + cap + std::to_string(s.options.threads));
-  }
-  if (app.count("--dt-m")) s.options.magnetics.dt = a.dt_m;
-  if (app.count("--tol")) s.options.magnetics.tol = a.tol;
-  if (app.count("--max-iter")) s.options.magnetics.max_iter = a.max_iter;
-  if (app.count("--quickstep-iterations")) s.options.quickstep_iterations = a.quickstep_iterations;
-  if (app.count("--auto-disable")) s.options.auto_disable = true;
-  if (app.count("--force-model") && !mag::kForceModelNames.parse(a.force_model, &s.options.force_model))
-    throw UsageError("--force-model: " + mag::kForceModelNames.unknown("force model", a.force_model));
-  if (app.count("--max-substeps")) s.options.max_substeps = a.max_substeps;
-  if (app.count("--substep-reach")) s.options.substep_reach = a.substep_reach;
-  if (app.count("--substep-load")) s.options.substep_load = on_off("--substep-load", a.substep_load);
-  if (app.count("--balance-magnetic-torque"))
-    s.options.balance_magnetic_torque = on_off("--balance-magnetic-torque", a.balance_magnetic_torque);
-  if (app.count("--rolling-friction")) s.options.rolling_friction = a.rolling_friction;
-  if (app.count("--rolling-friction-bodies")) s.options.rolling_friction_bodies = a.rolling_friction_bodies;
-  if (app.count("--eddy-conductivity")) s.options.eddy_conductivity = a.eddy_conductivity;
-  if (app.count("--energy-guard")) s.options.energy_guard = on_off("--energy-guard", a.energy_guard);
-  if (app.count("--energy-guard-tolerance")) s.options.energy_guard_tolerance = a.energy_guard_tolerance;
-  if (app.count("--energy-guard-floor")) s.options.energy_guard_floor = a.energy_guard_floor;
-  if (app.count("--energy-guard-max-substeps")) s.options.energy_guard_max_substeps = a.energy_guard_max_substeps;
-  if (app.count("--quickstep-w")) s.options.quickstep_w = a.quickstep_w;
-  if (app.count("--dt")) s.options.dt = a.dt;
-  if (app.count("--bounded-pairs"))
-    s.options.magnetics.field.bounded_pairs = on_off("--bounded-pairs", a.bounded_pairs);
-  if (app.count("--softening")) s.options.magnetics.field.softening = a.softening;
-  if (app.count("--space")) {
-    if (!engine::parse_space(a.space, &s.options.space))
-      throw UsageError("--space: " + engine::kSpaceNames.unknown("broad phase", a.space));
-  }
-  mag::FieldOptions& f = s.options.magnetics.field;
+  // the option flags given (the table's: engine/options_table.hpp); the scene's values stand
+  // for the rest
   try {
-    a.field.apply(&f);
+    a.options.apply(&s.options);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  if (const std::string e = mag::validate(f); !e.empty()) throw UsageError("field options: " + e);
+  // the thread cap holds for the flag and the scene file alike (--write-scene too)
+  if (s.options.threads > tools::max_threads())
+    throw UsageError((app.count("--threads") ? std::string("--threads: ") : a.scene + ": options.threads: ") +
+                     "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
+                     std::to_string(tools::max_threads() / 4) + " cores), got " + std::to_string(s.options.threads));
   return s;
 }
 
@@ -246,12 +205,6 @@ int main(int argc, char** argv) {
                "moments.csv"};
   Args a;
   app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
-  app.add_option("--method", a.method,
-                 mag::kMethodNames.list(" | ") +
-                     " (default: the scene's, anderson: M = f(H(M)) converged every sub-step, with the classic "
-                     "force, -grad of the co-energy U*; ours = the paper as printed: theta dynamics eqs. 8-11 and "
-                     "eq. 4, which has no energy; kim2018 = the baseline)")
-      ->check(CLI::IsMember(mag::kMethodNames.names()));
   auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
                       ->check(kFinitePositive);
   auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(tools::Range(1L, static_cast<long>(kMaxSteps)));
@@ -265,73 +218,10 @@ int main(int argc, char** argv) {
   app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(tools::Range(16, 8192) & kEven)->capture_default_str();
   app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(tools::Range(1, 4))->capture_default_str();
   app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
-  app.add_option("--threads", a.threads, "OpenMP threads for the magnetics, at most 4 x the cores (0: sized to the free cores, the default)")->check(tools::OptionCheck("threads"));
   app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(tools::Range(1, 1000000000));
   app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(tools::PositiveNumber);
-  app.add_option("--dt-m", a.dt_m, "magnetization time step Δt_m (s), e.g. 1e-7, in [1e-9, 1e-6]")->check(tools::OptionCheck("magnetics.dt"));
-  app.add_option("--tol", a.tol, "magnetization convergence tolerance, in (0, 1)")->check(tools::OptionCheck("magnetics.tol"));
-  app.add_option("--max-iter", a.max_iter, "magnetization iteration cap per solve, in [1, 1000000]")->check(tools::OptionCheck("magnetics.max_iter"));
-  app.add_option("--quickstep-iterations", a.quickstep_iterations,
-                 "ODE QuickStep (contact solver) iterations per rigid step (default: the scene's, 20)")
-      ->check(tools::OptionCheck("quickstep_iterations"));
-  app.add_option("--space", a.space, "ODE broad phase: " + engine::kSpaceNames.list(" | ") + " (default: the scene's, sap)");
-  app.add_flag("--auto-disable", a.auto_disable, "let ODE put resting bodies to sleep (woken when their magnetic load changes)");
-  app.add_option("--force-model", a.force_model,
-                 "force on induced moments: method (the method's own: classic for anderson, exact and kim2018, "
-                 "eq. 4 for ours, ours-realigned and damping-llg) | zeeman (eq. 4, not the gradient of any energy) "
-                 "| classic (eqs. 13-14, -grad U* with converged magnetizations) | zeeman-total (eq. 4 as the "
-                 "gradient of the system's Zeeman energy: conservative) (default: the scene's, method)");
-  app.add_option("--energy-guard", a.energy_guard,
-                 "on | off: retake a rigid step in twice the sub-steps when E = K + U_g + U* rises by more than "
-                 "the tolerance (default on; unavailable for eq. 4 (zeeman), which has no energy: never applied "
-                 "there, summary.json energy.guard says so)");
-  app.add_option("--energy-guard-tolerance", a.energy_guard_tolerance,
-                 "the guard's tolerance relative to the step's K_start + K_end + |U*_start| (default 1e-3)")
-      ->check(tools::OptionCheck("energy_guard_tolerance"));
-  app.add_option("--energy-guard-floor", a.energy_guard_floor,
-                 "the guard's absolute tolerance per step, J (default 1e-6)")
-      ->check(tools::OptionCheck("energy_guard_floor"));
-  app.add_option("--energy-guard-max-substeps", a.energy_guard_max_substeps,
-                 "most sub-steps the guard retakes a frame in (default 32)")
-      ->check(tools::OptionCheck("energy_guard_max_substeps"));
-  app.add_option("--max-substeps", a.max_substeps,
-                 "most rigid sub-steps per frame; a frame is split when bodies touching each other move fast or bodies "
-                 "in contact are pressed hard by the magnetic force (1 = never; default: the scene's)")
-      ->check(tools::OptionCheck("max_substeps"));
-  app.add_option("--substep-reach", a.substep_reach,
-                 "fraction of the smallest dynamic shape radius a body may cover per sub-step (default 0.25)")
-      ->check(tools::OptionCheck("substep_reach"));
-  app.add_option("--substep-load", a.substep_load,
-                 "on | off: also split a frame by the magnetic acceleration a of bodies in contact, "
-                 "a h^2 <= reach * r_min per sub-step (default on)");
-  app.add_option("--balance-magnetic-torque", a.balance_magnetic_torque,
-                 "on | off: cancel the net torque that eq. 4's reaction-symmetric forces leave (they sum to "
-                 "zero, their torques do not), by the least forces that do, where the torque arises; needs "
-                 "reaction-symmetric forces (default: the scene's, off in every registry scene)");
-  app.add_option("--rolling-friction", a.rolling_friction,
-                 "rolling resistance rho (m): contacts resist rolling with a torque <= rho * normal force (0 = none; default: the scene's)")
-      ->check(tools::OptionCheck("rolling_friction"));
-  app.add_option("--rolling-friction-bodies", a.rolling_friction_bodies,
-                 "the same between two dynamic bodies (a ball rolling on a ball), rho (m) (0 = none; default: the scene's)")
-      ->check(tools::OptionCheck("rolling_friction_bodies"));
-  app.add_option("--eddy-conductivity", a.eddy_conductivity,
-                 "electrical conductivity sigma (S/m) of the induced bodies: eddy-current loss where their flux "
-                 "density changes in their own frame (iron 1e7; 0 = none; default: the scene's)")
-      ->check(tools::OptionCheck("eddy_conductivity"));
-  app.add_option("--quickstep-w", a.quickstep_w, "ODE QuickStep over-relaxation W in (0, 2) (default: the scene's, 1.3)")
-      ->check(tools::OptionCheck("quickstep_w"));
-  app.add_option("--dt", a.dt, "rigid (frame) step dt_r in seconds, in (0, 0.1] (default: the scene's, 1e-3)")
-      ->check(tools::OptionCheck("dt"));
-  app.add_option("--bounded-pairs", a.bounded_pairs,
-                 "on | off: evaluate a pair of moments no closer than the sum of their interaction radii (default: the scene's, off)");
-  app.add_option("--softening", a.softening,
-                 "dipole softening length eps (m): |r|^2 -> |r|^2 + eps^2 in every field, Jacobian and "
-                 "force, in [0, 0.1] (default: the scene's)")
-      ->check(tools::OptionCheck("magnetics.softening"));
-  a.field.add(&app,
-              mag::kFieldSolverNames.list(" | ") + ": how the dipole fields are summed, for the magnetization "
-              "and the forces alike (default: the scene's, auto); auto = Barnes-Hut from "
-              "--bh-threshold moments on");
+  // the run options' flags, one per entry of the table that has one
+  a.options.add(&app, "Options of the run (each overrides the scene's options.<key>; the scene file's ranges)");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
   app.add_option("--write-scene", a.write_scene,
                  "write the scene (with --count, --strength and the option flags applied) as a scene "
@@ -343,7 +233,7 @@ int main(int argc, char** argv) {
                                       "MemAvailable or what ulimit -v leaves, scene files that are not regular "
                                       "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
                                       std::string(tools::kMagsimKernelHelp) + "\n"
-                                      "Every option flag has the range of its scene-file key (scenes/option_ranges.hpp).\n"
+                                      "Every option flag has the range of its scene-file key (engine/options_table.cpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
                                       "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
                                       "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
