@@ -238,9 +238,32 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   return q;
 }
 
-// ΔT v = (A − B) r̂ (r̂·v) + B v
-Vec3 apply_coupling(const PairGeometry& q, const Vec3& v) {
-  return (q.A - q.B) * q.rhat.dot(v) * q.rhat + q.B * v;
+}  // namespace
+
+namespace {
+bool same_description(const MomentDesc& a, const MomentDesc& b) {
+  return a.position == b.position && a.m_perm == b.m_perm && a.volume == b.volume &&
+         a.radius == b.radius && a.group == b.group && a.kind == b.kind && a.Ms == b.Ms &&
+         a.H0 == b.H0;
+}
+
+// K = c ΔT(r) of every near pair, rebuilt only when the description or μr changed
+const std::vector<NearCoupling>& couplings_of(const MomentDesc& set, const NearFieldOptions& opt,
+                                              NearFieldWorkspace* ws) {
+  if (ws->cached && ws->key_mu_r == opt.mu_r && same_description(ws->key, set)) return ws->couplings;
+  find_near_pairs(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  ws->couplings.clear();
+  for (const NearPair& p : ws->pairs) {
+    const PairGeometry q = geometry(set, tab, *ws, p, false);
+    const double c = q.S * q.fade.phi;
+    const Mat3 K = c * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
+    ws->couplings.push_back({p.i, p.j, K});
+  }
+  ws->key = set;
+  ws->key_mu_r = opt.mu_r;
+  ws->cached = true;
+  return ws->couplings;
 }
 }  // namespace
 
@@ -248,42 +271,25 @@ void near_field_couplings(const MomentDesc& set, const NearFieldOptions& opt,
                           NearFieldWorkspace* ws, std::vector<NearCoupling>* out) {
   out->clear();
   if (opt.model != NearField::Pair) return;
-  find_near_pairs(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  for (const NearPair& p : ws->pairs) {
-    const PairGeometry q = geometry(set, tab, *ws, p, false);
-    const double c = q.S * q.fade.phi;
-    const Mat3 K = c * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
-    out->push_back({p.i, p.j, K});
-  }
+  *out = couplings_of(set, opt, ws);
 }
 
 void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
                     NearFieldWorkspace* ws, std::vector<Vec3>* H) {
   if (opt.model != NearField::Pair) return;
-  find_near_pairs(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  for (const NearPair& p : ws->pairs) {
-    const PairGeometry q = geometry(set, tab, *ws, p, false);
-    const double c = q.S * q.fade.phi;
-    if (c == 0) continue;
-    (*H)[p.i] += c * apply_coupling(q, moment(set, mz, p.j));
-    (*H)[p.j] += c * apply_coupling(q, moment(set, mz, p.i));
+  for (const NearCoupling& c : couplings_of(set, opt, ws)) {
+    (*H)[c.i] += c.K * moment(set, mz, c.j);
+    (*H)[c.j] += c.K * moment(set, mz, c.i);
   }
 }
 
-// E_ij = −μ0 c W,  W = (A − B)(m_i·r̂)(m_j·r̂) + B m_i·m_j
+// E_ij = −μ0 m_iᵀ K m_j,  K = c ΔT
 double near_field_energy(const MomentDesc& set, const Magnetization& mz,
                          const NearFieldOptions& opt, NearFieldWorkspace* ws) {
   if (opt.model != NearField::Pair) return 0.0;
-  find_near_pairs(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
   double E = 0;
-  for (const NearPair& p : ws->pairs) {
-    const PairGeometry q = geometry(set, tab, *ws, p, false);
-    const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
-    E -= kMu0 * q.S * q.fade.phi * mi.dot(apply_coupling(q, mj));
-  }
+  for (const NearCoupling& c : couplings_of(set, opt, ws))
+    E -= kMu0 * moment(set, mz, c.i).dot(c.K * moment(set, mz, c.j));
   return E;
 }
 

@@ -99,10 +99,21 @@ double pair_switch(double g, double* dS_dg = nullptr);
 struct NearPair {
   int i, j;
 };
-/// Pair list and table, rebuilt per call (positions change every step); the table is kept
-/// while μr does not change.
+/// The pair model's coupling of one near pair: the field at i is K m_j and at j is K m_i,
+/// K = c ΔT(r_ij) (symmetric, even in r; 1/m³).
+struct NearCoupling {
+  int i, j;
+  Mat3 K;
+};
+/// Pair list, couplings and table. The couplings depend on the description only (positions,
+/// permanent moments, H0, …), so they are kept while it and μr stay the same: the
+/// magnetization solve evaluates the field many times per step at one set of positions.
 struct NearFieldWorkspace {
   std::vector<NearPair> pairs;
+  std::vector<NearCoupling> couplings;  ///< of `key`'s near pairs, when `cached`
+  MomentDesc key;                       ///< the description the couplings are of
+  double key_mu_r = 0;
+  bool cached = false;
   std::vector<double> a;  ///< (n) sphere radius of each eligible moment, 0 = not eligible
   std::vector<int> perm;  ///< the permanent moments (the sources of H_app)
   std::vector<std::pair<long long, int>> cells;  ///< scratch: (grid cell, moment)
@@ -113,12 +124,6 @@ struct NearFieldWorkspace {
 /// Lists the eligible pairs (i < j, in that order) of `set` closer than the cut-off.
 void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws);
 
-/// The pair model's coupling of one near pair: the field at i is K m_j and at j is K m_i,
-/// K = c ΔT(r_ij) (symmetric, even in r; 1/m³).
-struct NearCoupling {
-  int i, j;
-  Mat3 K;
-};
 /// Every near pair's coupling (the Newton ground truth adds them to its interaction matrix).
 /// Depends on positions and permanent moments only. Empty for NearField::Dipole.
 void near_field_couplings(const MomentDesc& set, const NearFieldOptions& opt,

@@ -156,3 +156,33 @@ TEST_CASE("pair model: the coupling, switch and fade are smooth and as documente
   o.mu_r = 1000.0;
   CHECK(validate(o).empty());
 }
+
+TEST_CASE("pair model: the cached couplings follow the description", "[near_field]") {
+  // one workspace through three descriptions: each gives the field a fresh workspace gives
+  MomentSet s;
+  const double a = kBallRadius;
+  s.add_induced(Vec3(0, 0, 0), ball_volume(), kIronMs);
+  s.add_induced(Vec3(0, 0, 2.01 * a), ball_volume(), kIronMs);
+  s.add_induced(Vec3(2.3 * a, 0, 0), ball_volume(), kIronMs);
+  s.add_permanent(Vec3(0, 0, 0.03), 1e-6, Vec3(0, 0, 2.0));
+  for (std::size_t j = 0; j < 3; ++j) s.set_magnetization(j, Vec3(1e4, 2e4 * j, 3e4));
+  NearFieldOptions o;
+  o.model = NearField::Pair;
+  NearFieldWorkspace reused;
+  auto field = [&](const MomentSet& t, NearFieldWorkspace* ws) {
+    std::vector<Vec3> H(t.size(), Vec3::Zero());
+    add_near_field(t, t, o, ws, &H);
+    return H;
+  };
+  MomentSet moved = s, turned = s;
+  moved.position[1].z() += 0.1 * a;
+  turned.m_perm[3] = Vec3(0, 1.5, 1.0);
+  for (const MomentSet* t : {&s, &moved, &s, &turned}) {
+    NearFieldWorkspace fresh;
+    const auto Hr = field(*t, &reused), Hf = field(*t, &fresh);
+    for (std::size_t j = 0; j < t->size(); ++j) CHECK(Hr[j] == Hf[j]);
+    CHECK(near_field_energy(*t, *t, o, &reused) == near_field_energy(*t, *t, o, &fresh));
+  }
+  CHECK(field(s, &reused)[0] != field(moved, &reused)[0]);
+  CHECK(field(s, &reused)[0] != field(turned, &reused)[0]);
+}
