@@ -95,15 +95,7 @@ def main(argv=None):
         sel = [r for r in rows_lin if r[0] == field]
         for k, model in enumerate(MODELS):
             ax.plot([r[1] for r in sel], [r[3 + k] for r in sel], marker=".", label=model)
-        ax.axhline(1.0, color="grey", lw=0.8)
-        ax.set_xscale("log")
-        if field == "axial":
-            ax.set_yscale("log")
-        ax.set_xlabel("gap g / a")
-        ax.set_ylabel("engine force / exact force")
-        ax.set_title(f"{field}, H0 = 1e-4 Ms (linear)")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
+        ts.style_gap_axes(ax, field, "engine force / exact force", f"{field}, H0 = 1e-4 Ms (linear)")
     ax = axes[2]
     for k, model in enumerate(MODELS):
         ax.plot([r[0] for r in rows_sat], [r[2 + k] for r in rows_sat], marker="o", label=model)

@@ -457,6 +457,19 @@ def chart_gaps():
     return np.unique(np.concatenate((grid, [0.01, 0.1, 1.0])))
 
 
+def style_gap_axes(ax, field, ylabel, title):
+    """A force-ratio chart against the gap: log gap, log ratio for the axial field, 1 marked."""
+    ax.axhline(1.0, color="grey", lw=0.8)
+    ax.set_xscale("log")
+    if field == "axial":
+        ax.set_yscale("log")
+    ax.set_xlabel("gap g / a")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+
+
 def cmd_chart(args):
     import csv
     import os
@@ -487,15 +500,8 @@ def cmd_chart(args):
         for mu in mus:
             sel = [r for r in rows if r[0] == field and r[1] == fmt_mu(mu)]
             ax.plot([r[2] for r in sel], [r[5] for r in sel], marker=".", label=f"mu = {fmt_mu(mu)}")
-        ax.axhline(1.0, color="grey", lw=0.8)
-        ax.set_xscale("log")
-        if field == "axial":
-            ax.set_yscale("log")
-        ax.set_xlabel("gap g / a")
-        ax.set_ylabel("F exact / F dipole model")
-        ax.set_title(f"{field} field ({'attraction' if field == 'axial' else 'repulsion'})")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
+        style_gap_axes(ax, field, "F exact / F dipole model",
+                       f"{field} field ({'attraction' if field == 'axial' else 'repulsion'})")
     fig.suptitle("Two spheres: exact linear force / one self-consistent dipole per sphere (classic force)")
     fig.tight_layout()
     png_path = os.path.join(args.out, "two_spheres_ratio.png")
