@@ -119,8 +119,10 @@ inline void compute_fields(const MomentSet& set, const FieldOptions& opt, std::v
   compute_fields(set, set, opt, H, J, ws);
 }
 
-/// The direct sum of compute_fields at the listed moments only (H, J sized like targets).
-/// Used to measure Barnes–Hut errors and to time the direct kernel on a sample of targets.
+/// The direct sum of compute_fields at the listed moments only (H, J sized like targets),
+/// the dipoles alone: the near-field pair term, which acts on induced moments only, is not
+/// added. Used at permanent moments (ZeemanTotal), to measure Barnes–Hut errors and to time
+/// the direct kernel on a sample of targets.
 void compute_fields_at(const MomentDesc& set, const Magnetization& mz, const FieldOptions& opt,
                        const std::vector<int>& targets, std::vector<Vec3>* H,
                        std::vector<Mat3>* J, FieldWorkspace* ws);

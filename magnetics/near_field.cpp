@@ -116,8 +116,7 @@ double pair_switch(double g, double* dS_dg) {
 // φ = 1/(1 + z), z = (h/h0)^p, h0 = h0* at every gap: c Δt must fall with the gap for the
 // correction to attract, and a fade that sets in later at wider gaps (h0 growing faster than
 // g^0.15 near contact) makes it repel — against the finite-element data's sign
-PairFade pair_fade(double h, double g) {
-  (void)g;
+PairFade pair_fade(double h) {
   PairFade f;
   if (h <= 0) return f;
   const double z = std::pow(h / kPairFadeField, kPairFadePower);
@@ -136,6 +135,7 @@ const PairCouplingTable& NearFieldWorkspace::table_for(double mu_r) {
 
 void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   const std::size_t n = set.size();
+  ws->cached = false;
   ws->pairs.clear();
   ws->a.assign(n, 0.0);
   ws->perm.clear();
@@ -199,7 +199,7 @@ struct PairGeometry {
   double rho = 0, a = 0, g = 0;
   double A = 0, B = 0, dA = 0, dB = 0;  // Δt∥/a³, Δt⊥/a³ and d/dρ
   double S = 0, dS = 0;                  // switch and dS/dρ
-  PairFade fade;                         // φ, ∂φ/∂h, ∂φ/∂g
+  PairFade fade;                         // φ, ∂φ/∂h
   Vec3 Hhat = Vec3::Zero();              // direction of H_app
   double Ms = 0;
   Mat3 Japp = Mat3::Zero();              // ∂H_app/∂x at the midpoint
@@ -234,7 +234,7 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   q.Ms = 0.5 * (set.Ms[p.i] + set.Ms[p.j]);
   const double Hn = H.norm();
   if (Hn > 0) q.Hhat = H / Hn;
-  q.fade = pair_fade(q.Ms > 0 ? Hn / q.Ms : 0.0, q.g);
+  q.fade = pair_fade(q.Ms > 0 ? Hn / q.Ms : 0.0);
   return q;
 }
 
@@ -293,10 +293,10 @@ double near_field_energy(const MomentDesc& set, const Magnetization& mz,
   return E;
 }
 
-// With r = p_i − p_j, ρ = |r|, c = S(g) φ(h, g), h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
+// With r = p_i − p_j, ρ = |r|, c = S(g) φ(h), h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
 //   ∂W/∂r = [(A' − B') P + B' Q] r̂ + (A − B) ∇_r P,
 //   ∇_r P = [(m_j·r̂)(m_i − (m_i·r̂) r̂) + (m_i·r̂)(m_j − (m_j·r̂) r̂)]/ρ,
-//   ∂c/∂ρ = S' φ + S ∂φ/∂g / a,   ∇_x c = S (∂φ/∂h) J_app Ĥ / Ms   (J_app symmetric),
+//   ∂c/∂ρ = (dS/dρ) φ,   ∇_x c = S (∂φ/∂h) J_app Ĥ / Ms   (J_app symmetric),
 //   F_i = μ0 [c ∂W/∂r + W (∂c/∂ρ r̂ + ½ ∇_x c)],  F_j = μ0 [−c ∂W/∂r − W ∂c/∂ρ r̂ + ½ W ∇_x c],
 //   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 W S (∂φ/∂h)/Ms J_k Ĥ,
 //                                           τ_k = μ0 W S (∂φ/∂h)/Ms m_k × h(x − p_k, Ĥ).
@@ -304,12 +304,12 @@ void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
                            const NearFieldOptions& opt, NearFieldWorkspace* ws,
                            std::vector<Vec3>* F, std::vector<Vec3>* tau) {
   if (opt.model != NearField::Pair) return;
-  find_near_pairs(set, ws);
+  couplings_of(set, opt, ws);  // the pair list of `set` (compute_fields has made it already)
   const PairCouplingTable& tab = ws->table_for(opt.mu_r);
   for (const NearPair& p : ws->pairs) {
     const PairGeometry q = geometry(set, tab, *ws, p, true);
     const double c = q.S * q.fade.phi;
-    const double dc = q.dS * q.fade.phi + q.S * q.fade.dphi_dg / q.a;
+    const double dc = q.dS * q.fade.phi;
     if (c == 0 && dc == 0) continue;
     const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
     const double ui = mi.dot(q.rhat), uj = mj.dot(q.rhat);

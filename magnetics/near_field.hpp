@@ -63,8 +63,7 @@ inline constexpr double kPairCutoffGap = 2.0;     ///< S = 0 from this gap on: p
 inline constexpr double kPairContactGap = 1.5e-3; ///< g_m: what contact reads as, 7.5 µm at a = 5 mm
 inline constexpr double kPairSmoothGap = 5e-4;    ///< g_s: the width of the step to g_m
 inline constexpr double kPairFadeField = 0.0138;  ///< h0 (|H_app|/Ms)
-inline constexpr double kPairFadePower = 1.2;     ///< p
-inline constexpr double kPairFadeGap = 0.003;     ///< the gap of the fit
+inline constexpr double kPairFadePower = 1.2;     ///< p (h0 and p fitted at a gap of 0.003a)
 
 /// g_e of a gap g and dg_e/dg.
 double pair_effective_gap(double g, double* dge_dg = nullptr);
@@ -87,11 +86,11 @@ class PairCouplingTable {
   std::vector<double> par_, perp_, par2_, perp2_;  // node values and spline second derivatives
 };
 
-/// The saturation fade φ(h) and its derivative (dphi_dg: 0, h0 is gap-independent).
+/// The saturation fade φ(h) and dφ/dh (the same at every gap).
 struct PairFade {
-  double phi = 1, dphi_dh = 0, dphi_dg = 0;
+  double phi = 1, dphi_dh = 0;
 };
-PairFade pair_fade(double h, double g);
+PairFade pair_fade(double h);
 /// The cut-off step S(g) and dS/dg.
 double pair_switch(double g, double* dS_dg = nullptr);
 
@@ -121,7 +120,8 @@ struct NearFieldWorkspace {
   const PairCouplingTable& table_for(double mu_r);
 };
 
-/// Lists the eligible pairs (i < j, in that order) of `set` closer than the cut-off.
+/// Lists the eligible pairs (i < j, in that order) of `set` closer than the cut-off (and
+/// drops the cached couplings: they are of the pairs last listed for their description).
 void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws);
 
 /// Every near pair's coupling (the Newton ground truth adds them to its interaction matrix).

@@ -40,8 +40,8 @@ struct FieldFlags {
                                    " (pair: exact two-sphere couplings, faded as the contact saturates; "
                                    "classic force only). Default: the scene's (registry scenes: dipole)");
     mu_r_opt = app->add_option("--near-field-mu-r", mu_r,
-                               "initial relative permeability of the iron, read by --near-field pair, "
-                               "in [10, 10000]")
+                               "initial relative permeability of the iron, read by --near-field pair")
+                   ->check(OptionCheck("magnetics.field.near_field.mu_r"))
                    ->capture_default_str();
   }
   bool has_solver() const { return solver_opt && solver_opt->count() > 0; }
@@ -65,12 +65,6 @@ struct FieldFlags {
     mag::NearField m;
     if (near_opt && near_opt->count() && !mag::kNearFieldNames.parse(near_field, &m))
       throw std::invalid_argument(mag::kNearFieldNames.unknown("--near-field", near_field));
-    if (mu_r_opt && mu_r_opt->count()) {
-      mag::NearFieldOptions o;
-      o.mu_r = mu_r;
-      if (const std::string e = mag::validate(o); !e.empty())
-        throw std::invalid_argument("--near-field-mu-r: " + e);
-    }
   }
 
   /// Applies the flags given on the command line to f (after check()).
