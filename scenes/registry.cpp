@@ -276,10 +276,10 @@ SceneDesc falling_magnet(const SceneParams& p) {
 
 // ---------------------------------------------------------------------------------------
 // sakura_tree — 2500 iron balls (radius 4 mm) fall from a 50×50 grid 40 cm up onto a static
-// tree of capsules whose 8 branch ends each carry an N52 sphere magnet (radius 1.7 cm,
-// 22.6 A·m² = 1.1e6 A/m · 4/3 π (1.7 cm)³, |H| = 2M/3 ≈ 0.46 Ms at its poles). Sized for
+// tree of capsules whose 8 branch ends each carry an N52 sphere magnet (radius 1.75 cm,
+// 24.7 A·m² = 1.1e6 A/m · 4/3 π (1.75 cm)³, |H| = 2M/3 ≈ 0.46 Ms at its poles). Sized for
 // the classic force (the default): the 1.2 cm magnets eq. 4 needed hold about 200 balls with
-// it, these about 390 (tools/findings/sakura_tree.md).
+// it, 1.7 cm about 387 and these about 398 (tools/findings/energy.md).
 SceneDesc sakura_tree(const SceneParams& p) {
   SceneDesc s;
   s.name = "sakura_tree";
@@ -322,8 +322,8 @@ SceneDesc sakura_tree(const SceneParams& p) {
       // the branch end: an N52 sphere magnet of radius Rt magnetized along the branch, a
       // static body of its own (coloured as a magnet); its collider keeps iron at ≥ Rt + r
       // from the dipole
-      const double Rt = 0.017;  // (m)
-      const Vec3 m = kN52M * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 22.6 A·m²
+      const double Rt = 0.0175;  // (m)
+      const Vec3 m = kN52M * sphere_volume(Rt) * p.strength * (tip - mid).normalized();  // 24.7 A·m²
       tips.push_back(magnet_body("tip_magnet_" + std::to_string(tips.size()), BodyType::Static, tip,
                                  ShapeKind::Sphere, Vec3(Rt, Rt, Rt), {permanent_moment(sphere_volume(Rt), m)}));
     }
