@@ -7,7 +7,7 @@
 // auto: Barnes–Hut from --bh-threshold moments on), or --field-solver when only that is given.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
-#include "tools/field_flags.hpp"
+#include "tools/cli/field_flags.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

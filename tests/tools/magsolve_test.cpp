@@ -1,4 +1,4 @@
-// Tests for tools/magsolve.cpp: the command line on good and bad input.
+// Tests for tools/cli/magsolve.cpp: the command line on good and bad input.
 #include "tests/tools/run_command.hpp"
 
 #include <catch2/catch.hpp>

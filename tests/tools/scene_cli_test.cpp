@@ -1,4 +1,4 @@
-// Tests for tools/magsim_scene/ (magsim-scene): the ODE flags (--space, --quickstep-iterations,
+// Tests for tools/cli/magsim_scene/ (magsim-scene): the ODE flags (--space, --quickstep-iterations,
 // --auto-disable) reach the run, and bad values are refused with a one-line error.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"

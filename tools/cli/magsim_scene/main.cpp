@@ -1,9 +1,9 @@
-// tools/magsim_scene/main.cpp — magsim-scene's command line: the flags, the scene they
+// tools/cli/magsim_scene/main.cpp — magsim-scene's command line: the flags, the scene they
 // name with their overrides applied (resolve_scene), --list, and the exit codes.
 #include "scenes/options_json.hpp"
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
-#include "tools/magsim_scene/magsim_scene.hpp"
+#include "tools/cli/magsim_scene/magsim_scene.hpp"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,4 +1,4 @@
-// tools/magsim_scene/run.cpp — runs one scene (from the registry or a JSON file) with one
+// tools/cli/magsim_scene/run.cpp — runs one scene (from the registry or a JSON file) with one
 // method and writes what happened: summary.json (options, timings T_i/T_f/T_r, iteration
 // statistics, final metrics — attached, held, escaped beyond escape_radius, … —, the
 // energy audit, per-frame series, state hash, error), states.csv (body poses per frame) and
@@ -13,8 +13,8 @@
 #include "engine/cpu_share.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/scene_file.hpp"
-#include "tools/magsim_scene/outputs.hpp"
-#include "tools/replace_file.hpp"
+#include "tools/cli/magsim_scene/outputs.hpp"
+#include "tools/cli/replace_file.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -356,7 +356,7 @@ int run(const Args& a, const CLI::App& app) {
       {"signal", stop ? json(signal_name(stop)) : json(nullptr)},
       {"error", !error.empty() ? json(error) : !io_error.empty() ? json(io_error) : json(nullptr)}};
 
-  // written to a unique temporary name and renamed when complete (tools/replace_file.hpp): a
+  // written to a unique temporary name and renamed when complete (tools/cli/replace_file.hpp): a
   // full disk leaves no summary.json that looks valid
   const fs::path path = fs::path(dir) / "summary.json";
   try {
@@ -392,7 +392,7 @@ int run(const Args& a, const CLI::App& app) {
 
 
 // --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written whole
-// through a temporary file (tools/replace_file.hpp): a regular file or a symlink to one is
+// through a temporary file (tools/cli/replace_file.hpp): a regular file or a symlink to one is
 // replaced, a missing one created; a directory, device, FIFO or dangling link is refused.
 int write_scene(const Args& a, const CLI::App& app) {
   const engine::SceneDesc scene = resolve_scene(a, app);

@@ -1,4 +1,4 @@
-// tools/replace_file.hpp — writing a whole file so that a failed write never leaves half of
+// tools/cli/replace_file.hpp — writing a whole file so that a failed write never leaves half of
 // it under the name: the text goes to a new temporary file beside the target and is renamed
 // over it when complete. Renaming is right for regular files only: a device node, FIFO,
 // socket or directory at the path is refused (a rename turns a device node into a plain file

@@ -1,4 +1,4 @@
-// tools/cli_common.hpp — what magsim-scene and magsolve share on the command line: the exit
+// tools/cli/cli_common.hpp — what magsim-scene and magsolve share on the command line: the exit
 // codes, the help footer that states them, CLI11's parse with those codes and one-line
 // errors, the flag validators (decimal integers, ranges in %g), the thread cap that holds for
 // --threads and OMP_NUM_THREADS alike, and the signal dispositions of both programs.

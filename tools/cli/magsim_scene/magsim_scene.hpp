@@ -1,12 +1,12 @@
-// tools/magsim_scene/magsim_scene.hpp — what the files of magsim-scene share: the
+// tools/cli/magsim_scene/magsim_scene.hpp — what the files of magsim-scene share: the
 // command-line arguments, the errors that pick the exit code, and the entry points
 // (main.cpp: flags and the scene they name; run.cpp: the run and --write-scene;
 // outputs.hpp/.cpp: summary.json's parts, states.csv, moments.csv, frames).
 #pragma once
 
 #include "engine/scene_desc.hpp"
-#include "tools/cli_common.hpp"
-#include "tools/option_flags.hpp"
+#include "tools/cli/cli_common.hpp"
+#include "tools/cli/option_flags.hpp"
 
 #include <CLI/CLI.hpp>
 

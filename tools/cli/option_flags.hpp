@@ -1,4 +1,4 @@
-// tools/option_flags.hpp — magsim-scene's option flags: one per entry of the table of run
+// tools/cli/option_flags.hpp — magsim-scene's option flags: one per entry of the table of run
 // options that names a flag (engine/options_table.hpp), with the entry's range and a help
 // made of its doc, unit, scene-file key and default, applied to the scene's options when
 // given. A number takes its range (OptionCheck, as the scene file does); a bool takes on | off,
@@ -6,7 +6,7 @@
 #pragma once
 
 #include "engine/options_table.hpp"
-#include "tools/cli_common.hpp"
+#include "tools/cli/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -1,4 +1,4 @@
-// tools/magsolve.cpp — the magnetics core as a command-line tool: solves one configuration
+// tools/cli/magsolve.cpp — the magnetics core as a command-line tool: solves one configuration
 // of moments and prints, per moment, M, H, the Zeeman force and the classic force, plus the
 // iterations taken, whether the dynamics converged and e_M against the ground truth (eq. 12).
 //
@@ -11,7 +11,7 @@
 #include "scenes/json_unique_keys.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/text_file.hpp"
-#include "tools/cli_common.hpp"
+#include "tools/cli/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -1,10 +1,10 @@
-// tools/magsim_scene/outputs.hpp — what a run writes: the output folder, states.csv and
+// tools/cli/magsim_scene/outputs.hpp — what a run writes: the output folder, states.csv and
 // moments.csv with summary.json's per-frame series (Recorder), summary.json's energy audit,
 // and the frames (FrameRenderer).
 #pragma once
 
 #include "engine/simulation.hpp"
-#include "tools/magsim_scene/magsim_scene.hpp"
+#include "tools/cli/magsim_scene/magsim_scene.hpp"
 #ifdef MAGSIM_HAVE_RENDER
 #include "render/frame_writer.hpp"
 #include "render/renderer.hpp"

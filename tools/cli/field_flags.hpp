@@ -1,11 +1,11 @@
-// tools/field_flags.hpp — bench's dipole-field flags: --field-solver (mag::kFieldSolverNames),
+// tools/cli/field_flags.hpp — bench's dipole-field flags: --field-solver (mag::kFieldSolverNames),
 // --bh-theta θ, --bh-threshold N, --near-field (mag::kNearFieldNames), --near-field-mu-r μr, in
 // the ranges of their options (engine/options_table.hpp; magsim-scene's flags of the same
 // names come from that table). Flags not given leave the scene's FieldOptions as they are.
 #pragma once
 
 #include "magnetics/fields.hpp"
-#include "tools/cli_common.hpp"
+#include "tools/cli/cli_common.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -1,6 +1,6 @@
-// tools/magsim_scene/outputs.cpp — the output folder, CSV quoting and summary.json's energy
+// tools/cli/magsim_scene/outputs.cpp — the output folder, CSV quoting and summary.json's energy
 // audit (outputs.hpp).
-#include "tools/magsim_scene/outputs.hpp"
+#include "tools/cli/magsim_scene/outputs.hpp"
 
 #include <fstream>
 
@@ -13,7 +13,7 @@ namespace magsim::scene_tool {
 bool is_output_name(const std::string& f) {
   for (const char* n : kOutputNames)
     if (f == n) return true;
-  // summary.json's temporary file (tools/replace_file.hpp), left by a killed run
+  // summary.json's temporary file (tools/cli/replace_file.hpp), left by a killed run
   if (f.size() == 20 && f.compare(0, 14, ".summary.json.") == 0) return true;
   // a frame's temporary file (render/png_io.cpp), left by a killed run: .frame_%06d.png.XXXXXX
   if (f.size() > 8 && f[0] == '.' && f.compare(f.size() - 7, 1, ".") == 0 && is_output_name(f.substr(1, f.size() - 8)) &&
