@@ -1,7 +1,7 @@
 // tests/engine/cpu_share_test.cpp — the busy-machine thread count.
-#include "engine/cpu_share.hpp"
 #include "engine/simulation.hpp"
 #include "fixtures.hpp"
+#include "tools/cli/cpu_share.hpp"
 
 #include <catch2/catch.hpp>
 #include <omp.h>

@@ -10,9 +10,9 @@
 // Exit codes (the same in magsolve): 0 done, 1 bad usage, flags or scene, 2 the simulation
 // failed (SimulationError; summary.json holds the error and the last good state), 3 I/O
 // error (an output file could not be written).
-#include "engine/cpu_share.hpp"
 #include "scenes/options_json.hpp"
 #include "scenes/scene_file.hpp"
+#include "tools/cli/cpu_share.hpp"
 #include "tools/cli/magsim_scene/outputs.hpp"
 #include "tools/cli/replace_file.hpp"
 

@@ -1,4 +1,4 @@
-// engine/cpu_share.hpp — how many threads the magnetics should use on a machine that other
+// tools/cli/cpu_share.hpp — how many threads the magnetics should use on a machine that other
 // processes share ("busy machines").
 //
 // OpenMP's parallel regions end in barriers: when another process holds one of the cores,

@@ -1,5 +1,5 @@
-// engine/cpu_share.cpp — see cpu_share.hpp.
-#include "engine/cpu_share.hpp"
+// tools/cli/cpu_share.cpp — see cpu_share.hpp.
+#include "tools/cli/cpu_share.hpp"
 
 #include <algorithm>
 #include <cctype>
