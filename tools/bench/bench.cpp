@@ -1,4 +1,4 @@
-// tools/bench.cpp — Table 1 of the paper, measured: per scene and method the medians of
+// tools/bench/bench.cpp — Table 1 of the paper, measured: per scene and method the medians of
 // T_i, T_f, T_r per 1 ms rigid step over a window after a warm-up, the magnetization
 // iterations per step, and the ratio ours/Kim 2018 of T_i measured in the same run; plus the
 // scaling of the step with the number of balls (sakura_tree with N balls). Writes JSON.

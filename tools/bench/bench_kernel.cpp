@@ -1,4 +1,4 @@
-// tools/bench_kernel.cpp — speed (and, for Barnes–Hut, accuracy) of the dipole-field
+// tools/bench/bench_kernel.cpp — speed (and, for Barnes–Hut, accuracy) of the dipole-field
 // kernel of magnetics/dipole_field.cpp: pair evaluations per second of the direct sum (field
 // only, and field + Jacobian), single- and multi-threaded, and the Barnes–Hut approximation
 // (magnetics/barnes_hut.cpp) at several opening angles θ: time, speed-up over the direct sum,

@@ -1,4 +1,4 @@
-// tools/render_demo.cpp — magsim-render-demo: draws a pile of iron balls next to a bar
+// tools/bench/render_demo.cpp — magsim-render-demo: draws a pile of iron balls next to a bar
 // magnet, a capsule and a few field arrows, writes one PNG and prints the milliseconds per
 // frame (median of 5 draws). A development tool for looking at and timing the renderer.
 #include <algorithm>
