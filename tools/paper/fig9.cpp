@@ -1,5 +1,5 @@
-// tools/experiments/fig9.cpp — Fig. 9: the stability map over Δt × |H|, shardable.
-#include "tools/experiments/experiments.hpp"
+// tools/paper/fig9.cpp — Fig. 9: the stability map over Δt × |H|, shardable.
+#include "tools/paper/experiments.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-// tools/experiments/snapshot_speed.cpp — speed against accuracy on the sakura_tree snapshot, and the
+// tools/paper/snapshot_speed.cpp — speed against accuracy on the sakura_tree snapshot, and the
 // Barnes–Hut field error against its time per evaluation.
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <algorithm>
 #include <cmath>

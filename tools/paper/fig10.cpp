@@ -1,7 +1,7 @@
-// tools/experiments/fig10.cpp — Fig. 10: force magnitude near a uniformly magnetized sphere.
+// tools/paper/fig10.cpp — Fig. 10: force magnitude near a uniformly magnetized sphere.
 #include "magnetics/dipole_field.hpp"
 #include "magnetics/force_laws.hpp"
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <algorithm>
 #include <cstdio>

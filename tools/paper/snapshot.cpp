@@ -1,7 +1,7 @@
-// tools/experiments/snapshot.cpp — the sakura_tree snapshot shared by `tolerance` and `snapshot-speed`:
+// tools/paper/snapshot.cpp — the sakura_tree snapshot shared by `tolerance` and `snapshot-speed`:
 // the scene stepped until balls sit on the tree magnets, cached in the output directory, and
 // its ground truths.
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <omp.h>
 

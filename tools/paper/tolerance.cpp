@@ -1,6 +1,6 @@
-// tools/experiments/tolerance.cpp — convergence tolerance against force error on the sakura_tree
+// tools/paper/tolerance.cpp — convergence tolerance against force error on the sakura_tree
 // snapshot, and against a scene's outcome.
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// tools/experiments/main.cpp — the paper's magnetics experiments as data (CSV/JSON), and the
+// tools/paper/main.cpp — the paper's magnetics experiments as data (CSV/JSON), and the
 // speed-against-accuracy measurements beyond the paper. Charts: tools/charts.py.
 //
 //   experiments fig8     e_M per iteration on crystal_balls, weak and strong magnet (Fig. 8)
@@ -11,7 +11,7 @@
 //                               snapshot and against balls_up's outcome
 //   experiments snapshot-speed  e_M against wall time on a sakura_tree snapshot; Barnes–Hut
 //                               field error against time per evaluation
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <cstdio>
 

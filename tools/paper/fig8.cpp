@@ -1,6 +1,6 @@
-// tools/experiments/fig8.cpp — Fig. 8 (e_M per iteration on crystal_balls, weak and strong magnet)
+// tools/paper/fig8.cpp — Fig. 8 (e_M per iteration on crystal_balls, weak and strong magnet)
 // and the uniqueness figure of §6.3.
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <algorithm>
 #include <cstdio>

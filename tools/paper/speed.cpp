@@ -1,6 +1,6 @@
-// tools/experiments/speed.cpp — speed against accuracy on crystal_balls (weak and strong): e_M against
+// tools/paper/speed.cpp — speed against accuracy on crystal_balls (weak and strong): e_M against
 // cumulative wall time per dynamics and per Newton step; Δt_m against iterations to e_M ≤ 1e-4.
-#include "tools/experiments/experiments.hpp"
+#include "tools/paper/experiments.hpp"
 
 #include <cstdio>
 #include <fstream>

@@ -1,5 +1,5 @@
-// tools/experiments/common.cpp — the helpers every experiment shares (experiments.hpp).
-#include "tools/experiments/experiments.hpp"
+// tools/paper/common.cpp — the helpers every experiment shares (experiments.hpp).
+#include "tools/paper/experiments.hpp"
 
 #include <algorithm>
 #include <filesystem>

@@ -1,4 +1,4 @@
-// tools/experiments/experiments.hpp — what the experiment programs share: the helpers of
+// tools/paper/experiments.hpp — what the experiment programs share: the helpers of
 // every figure (methods, the crystal_balls moment set, fixed windows of sweeps, medians), the
 // speed-against-accuracy machinery, the sakura_tree snapshot, and one options struct and
 // run_* entry per subcommand (one file each: fig8.cpp, fig9.cpp, fig10.cpp, speed.cpp,
