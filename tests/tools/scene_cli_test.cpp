@@ -172,7 +172,7 @@ TEST_CASE("tools/ensemble.py: one row per perturbed run, each from its summary.j
   const std::string out = tmp_dir("ensemble");
   const std::string py = std::string("MAGSIM_SCENE_BIN=") + MAGSIM_SCENE_BIN + " /usr/bin/python3";
   const Result r = magsim::test::run_command(
-      py, std::string(MAGSIM_SOURCE_DIR) + "/tools/ensemble.py balls_up --runs 2 --seconds 0.02 --base-count 20 --out " +
+      py, std::string(MAGSIM_SOURCE_DIR) + "/tools/scripts/ensemble.py balls_up --runs 2 --seconds 0.02 --base-count 20 --out " +
               out + " -- --threads 1");
   INFO(r.out);
   REQUIRE(r.code == 0);
@@ -197,7 +197,7 @@ TEST_CASE("tools/ensemble.py: one row per perturbed run, each from its summary.j
   CHECK(j["failed"] == 0);
   // bad usage: exit 2 and a one-line reason
   for (const char* bad : {"balls_up --runs 0", "balls_up --seconds -1", "nosuch_scene", "balls_up --frobnicate"}) {
-    const Result b = magsim::test::run_command(py, std::string(MAGSIM_SOURCE_DIR) + "/tools/ensemble.py " + bad);
+    const Result b = magsim::test::run_command(py, std::string(MAGSIM_SOURCE_DIR) + "/tools/scripts/ensemble.py " + bad);
     INFO(bad << ": " << b.out);
     CHECK(b.code == 2);
     CHECK(b.out.find("ensemble.py:") != std::string::npos);

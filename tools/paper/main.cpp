@@ -1,5 +1,5 @@
 // tools/paper/main.cpp — the paper's magnetics experiments as data (CSV/JSON), and the
-// speed-against-accuracy measurements beyond the paper. Charts: tools/charts.py.
+// speed-against-accuracy measurements beyond the paper. Charts: tools/scripts/charts.py.
 //
 //   experiments fig8     e_M per iteration on crystal_balls, weak and strong magnet (Fig. 8)
 //                        and the uniqueness figure of §6.3
@@ -19,7 +19,7 @@ using namespace magsim::experiments;
 
 int main(int argc, char** argv) {
   CLI::App app{"experiments — the paper's magnetics figures as data (Figs. 8, 9, 10, §6.3) and "
-               "speed against accuracy. Charts: python3 tools/charts.py OUT_DIR"};
+               "speed against accuracy. Charts: python3 tools/scripts/charts.py OUT_DIR"};
   app.require_subcommand(1);
   Fig8Opts f8;
   auto* c8 = app.add_subcommand("fig8", "e_M per iteration on crystal_balls, weak and strong (Fig. 8); uniqueness (§6.3)");

@@ -179,7 +179,7 @@ const auto kFinitePositive = CLI::Validator(
     },
     "POSITIVE");
 
-// --width / --height: H.264 (tools/make_video.sh) needs even frame sizes
+// --width / --height: H.264 (tools/scripts/make_video.sh) needs even frame sizes
 const auto kEven = CLI::Validator(
     [](std::string& v) -> std::string {
       try {

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""tools/fuzz.py — mutates the example scene files and magsolve cases and runs the tools on
+"""tools/scripts/fuzz.py — mutates the example scene files and magsolve cases and runs the tools on
 them, bounded in count and time, with the hostile-input families.
 
-    python3 tools/fuzz.py [--seconds 60] [--count 100000] [--seed 1] [--out out/fuzz]
+    python3 tools/scripts/fuzz.py [--seconds 60] [--count 100000] [--seed 1] [--out out/fuzz]
                           [--bin build/release/tools]
 
 A case fails on: a signal death (crash, abort), a hang (over --timeout s), an exit code
@@ -25,7 +25,7 @@ else 0. Prints a closing line 'N passed, M failed'.
 """
 import argparse, csv, io, json, math, os, random, re, resource, shutil, signal, stat, subprocess, sys, time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENE = os.path.join(ROOT, "build/release/tools/magsim-scene")  # --bin sets both
 SOLVE = os.path.join(ROOT, "build/release/tools/magsolve")
 TWO_BALLS = os.path.join(ROOT, "scenes/examples/two_balls.json")
@@ -494,7 +494,7 @@ def main():
         ap.error("--seconds, --count and --timeout must be > 0")
     for b in (SCENE, SOLVE):
         if not os.access(b, os.X_OK):
-            sys.exit(f"fuzz.py: {b} not built (run tools/setup.sh --no-demo)")
+            sys.exit(f"fuzz.py: {b} not built (run tools/scripts/setup.sh --no-demo)")
     os.makedirs(a.out, exist_ok=True)
     rng = random.Random(a.seed)
     t0 = time.monotonic()

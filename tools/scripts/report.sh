@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# tools/report.sh — rebuilds the experiment report from scratch into out/report/: the paper's
+# tools/scripts/report.sh — rebuilds the experiment report from scratch into out/report/: the paper's
 # Table 1 and Figs. 8, 9, 10, the uniqueness figure (§6.3), speed against accuracy (crystal_balls
 # and a sakura_tree snapshot), tolerance against force error, and scaling, as CSV/JSON + PNG
 # charts + index.md. About 10–25 minutes on 2 cores.
 #
-#   bash tools/report.sh            reduced Fig. 9 grid (11 × 101 cells × 64 directions)
-#   bash tools/report.sh --quick    shorter benchmark windows, no 10,000-ball scaling point
+#   bash tools/scripts/report.sh            reduced Fig. 9 grid (11 × 101 cells × 64 directions)
+#   bash tools/scripts/report.sh --quick    shorter benchmark windows, no 10,000-ball scaling point
 # The full-resolution Fig. 9 is separate (hours):
 #   build/release/tools/experiments fig9 --dt-steps 51 --h-steps 1001 --dirs 10000 --shard i/n
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 quick=0
 for a in "$@"; do
   case "$a" in
@@ -18,7 +18,7 @@ for a in "$@"; do
     *) echo "report.sh: unknown option '$a' (try --help)" >&2; exit 2 ;;
   esac
 done
-bash tools/setup.sh --no-demo
+bash tools/scripts/setup.sh --no-demo
 out=out/report
 rm -rf "$out"
 mkdir -p "$out"
@@ -46,6 +46,6 @@ if [ -x $bin/bench_kernel ]; then
 fi
 echo "== two balls: dipole and pair model against exact magnetostatics"
 /usr/bin/python3 tools/reference/near_field_chart.py --out "$out" --magsolve $bin/magsolve | tee "$out/near_field.txt"
-/usr/bin/python3 tools/charts.py "$out"
-/usr/bin/python3 tools/report_index.py "$out"
+/usr/bin/python3 tools/scripts/charts.py "$out"
+/usr/bin/python3 tools/scripts/report_index.py "$out"
 echo "report: $out/index.md ($(( $(date +%s) - t0 )) s)"

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""tools/report_index.py — writes OUT_DIR/index.md: every chart of the report beside the
+"""tools/scripts/report_index.py — writes OUT_DIR/index.md: every chart of the report beside the
 paper's number and a sentence on where our result agrees or differs.
 
-    /usr/bin/python3 tools/report_index.py OUT_DIR"""
+    /usr/bin/python3 tools/scripts/report_index.py OUT_DIR"""
 import csv
 import datetime
 import json
@@ -172,7 +172,7 @@ def main():
     except (OSError, StopIteration):
         pass
     L.append("# magsim experiment report\n")
-    L.append(f"Generated {datetime.datetime.now():%Y-%m-%d %H:%M} by `bash tools/report.sh`, "
+    L.append(f"Generated {datetime.datetime.now():%Y-%m-%d %H:%M} by `bash tools/scripts/report.sh`, "
              f"commit {commit}, on {os.cpu_count()} cores ({cpu}). Paper: *Fast Stabilization "
              "of Inducible Magnet Simulation*. Timings are medians of "
              "one run on a shared machine; ratios are measured within the same run.\n")

@@ -1,16 +1,16 @@
 #!/usr/bin/env bash
-# tools/test.sh — builds the test suite and runs it with CTest.
+# tools/scripts/test.sh — builds the test suite and runs it with CTest.
 #
-#   bash tools/test.sh            Release build in build/release, every test
-#   bash tools/test.sh --asan     ASan+UBSan build in build/asan (renderer off), portable
-#   bash tools/test.sh --portable Release build in build/portable, portable
-#   bash tools/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability)
+#   bash tools/scripts/test.sh            Release build in build/release, every test
+#   bash tools/scripts/test.sh --asan     ASan+UBSan build in build/asan (renderer off), portable
+#   bash tools/scripts/test.sh --portable Release build in build/portable, portable
+#   bash tools/scripts/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability)
 # Portable: -DMAGSIM_NATIVE=OFF, baseline x86-64 and the portable field kernels, whose golden
 # state hashes hold on every x86-64 CPU (tests/engine/golden_hash_test.cpp); the Release
 # build checks the AVX-512 ones where the CPU has AVX-512.
-# Installs the Debian packages first if any is missing (tools/setup.sh --deps-only).
+# Installs the Debian packages first if any is missing (tools/scripts/setup.sh --deps-only).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 
 preset=release
 ctest_args=()
@@ -25,7 +25,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 
-bash tools/setup.sh --deps-only
+bash tools/scripts/setup.sh --deps-only
 if [ "$preset" = asan ]; then
   cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMAGSIM_SANITIZE=ON \
         -DMAGSIM_RENDER=OFF -DMAGSIM_NATIVE=OFF >/dev/null

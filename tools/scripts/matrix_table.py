@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""tools/matrix_table.py DIR — a Markdown table of every DIR/<scene>_<method>/summary.json:
+"""tools/scripts/matrix_table.py DIR — a Markdown table of every DIR/<scene>_<method>/summary.json:
 per-step medians of T_i, T_f, T_r (ms), magnetization iterations (median, cap hits), and the
 final kinetic energy, maximum speed, bounding radius and attached count."""
 import json

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# tools/setup.sh — installs magsim's Debian packages, builds it (Release), and runs the
+# tools/scripts/setup.sh — installs magsim's Debian packages, builds it (Release), and runs the
 # main job: the demo scene rendered to PNG frames and assembled into a video.
 #
-#   bash tools/setup.sh               install, build, run the demo  → out/demo/
-#   bash tools/setup.sh --no-demo     install and build only
-#   bash tools/setup.sh --deps-only   install the packages only
+#   bash tools/scripts/setup.sh               install, build, run the demo  → out/demo/
+#   bash tools/scripts/setup.sh --no-demo     install and build only
+#   bash tools/scripts/setup.sh --deps-only   install the packages only
 # Idempotent: packages already installed are not reinstalled; the build is incremental.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 
 deps_only=0
 demo=1
@@ -44,5 +44,5 @@ cmake --build build/release -j"$(nproc)"
 # the main job: a demo scene → PNG frames → H.264 video
 out=out/demo
 build/release/tools/magsim-scene balls_up --seconds 2 --out "$out"
-bash tools/make_video.sh "$out" "$out/balls_up.mp4"
+bash tools/scripts/make_video.sh "$out" "$out/balls_up.mp4"
 echo "setup: demo frames in $out/, video $out/balls_up.mp4, summary $out/summary.json"

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# tools/robustness.sh — the robustness matrix: each scene under the default method with
+# tools/scripts/robustness.sh — the robustness matrix: each scene under the default method with
 # QuickStep W 1.0 and 1.3, 20 and 50 QuickStep iterations, Δt_r 0.5/1/2 ms and strength ×1
 # and ×3 (24 runs a scene). No run may blow up: it must end without an error, with finite
 # metrics, and no body faster than the bound (default 20 m/s) at any frame. Where the force
 # has an energy, E = K + U_g + U* (summary.json series energy_total, from 0.05 s on) may
 # never stand above its running minimum by more than 1 % of what the run dissipates.
 #
-#   bash tools/robustness.sh [--seconds S] [--scenes a,b] [--bound V] [--out DIR] [--quick]
+#   bash tools/scripts/robustness.sh [--seconds S] [--scenes a,b] [--bound V] [--out DIR] [--quick]
 #                            [--flags "MAGSIM-SCENE FLAGS"]
 # Writes DIR/<scene>_<case>/summary.json and DIR/robustness.md (default DIR:
 # out/robustness); exits 1 when a run breaks the bound. --quick runs the corner cases only
@@ -15,7 +15,7 @@
 # across the matrix. At the default 1 s, the full matrix takes about 1 h on 2 cores
 # (sakura_tree dominates).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 seconds=1
 scenes=balls_up,alphabets,falling_magnet,sakura_tree
 bound=20
@@ -35,7 +35,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 bin=build/release/tools/magsim-scene
-[ -x "$bin" ] || { echo "robustness.sh: $bin not built (run tools/setup.sh --no-demo)" >&2; exit 1; }
+[ -x "$bin" ] || { echo "robustness.sh: $bin not built (run tools/scripts/setup.sh --no-demo)" >&2; exit 1; }
 mkdir -p "$out"
 IFS=, read -ra S <<< "$scenes"
 cases=()
@@ -57,7 +57,7 @@ for s in "${S[@]}"; do
     # shellcheck disable=SC2086  # --flags is a list of words
     "$bin" "$s" --seconds "$seconds" --no-render --fps 60 --out "$d" --quickstep-w "$w" \
         --quickstep-iterations "$it" --dt "$dt" --strength "$st" $flags >/dev/null 2>"$d.log" || true
-    row=$(python3 - "$d/summary.json" "$bound" "tools" <<'PY'
+    row=$(python3 - "$d/summary.json" "$bound" "tools/scripts" <<'PY'
 import json, math, sys
 sys.path.insert(0, sys.argv[3])
 from ensemble import energy_figures  # noqa: E402  (the ensembles' own measure of E)

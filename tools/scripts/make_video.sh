@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tools/make_video.sh — encode a folder of rendered frames (frame_000000.png, …) as an
+# tools/scripts/make_video.sh — encode a folder of rendered frames (frame_000000.png, …) as an
 # H.264 MP4 that plays everywhere (yuv420p; odd frame sizes are padded to even).
 set -euo pipefail
 

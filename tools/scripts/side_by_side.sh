@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tools/side_by_side.sh — two folders of rendered frames side by side in one H.264 MP4,
+# tools/scripts/side_by_side.sh — two folders of rendered frames side by side in one H.264 MP4,
 # each half labelled (default "ours" on the left, "Kim 2018" on the right).
 set -euo pipefail
 

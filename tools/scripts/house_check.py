@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""tools/house_check.py — the house rules that a script can check, in well under a second:
+"""tools/scripts/house_check.py — the house rules that a script can check, in well under a second:
 
-    python3 tools/house_check.py [ROOT] [--exclude DIR ...]
-    python3 tools/house_check.py --self-test
+    python3 tools/scripts/house_check.py [ROOT] [--exclude DIR ...]
+    python3 tools/scripts/house_check.py --self-test
 
 Prints one line per finding, FILE:LINE: what is wrong, and exits 1 when there is any:
 
@@ -260,7 +260,7 @@ def self_test_layers():
 
 
 def main():
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    here = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     ap = argparse.ArgumentParser(description="Checks the house rules (see the module docstring).")
     ap.add_argument("root", nargs="?", default=here)
     ap.add_argument("--exclude", action="append", default=[], metavar="DIR",

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# tools/scene_matrix.sh — every scene under every method for S simulated seconds (default 2),
+# tools/scripts/scene_matrix.sh — every scene under every method for S simulated seconds (default 2),
 # frames included, then a Markdown table of the per-step medians and final metrics.
 #
-#   bash tools/scene_matrix.sh [--seconds S] [--scenes a,b] [--methods a,b] [--no-render] [--out DIR]
+#   bash tools/scripts/scene_matrix.sh [--seconds S] [--scenes a,b] [--methods a,b] [--no-render] [--out DIR]
 # Writes DIR/<scene>_<method>/ (summary.json, states.csv, moments.csv, frames) and
 # DIR/table.md (default DIR: out/matrix). Sequential; at 2 s the five scenes × five methods take
 # about 40–60 minutes on 2 cores (sakura_tree under the methods that hit their cap dominates).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 seconds=2
 scenes=balls_up,alphabets,falling_magnet,sakura_tree,crystal_balls
 methods=ours-realigned,ours,kim2018,damping-llg,anderson
@@ -25,7 +25,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 bin=build/release/tools/magsim-scene
-[ -x "$bin" ] || { echo "scene_matrix.sh: $bin not built (run tools/setup.sh --no-demo)" >&2; exit 1; }
+[ -x "$bin" ] || { echo "scene_matrix.sh: $bin not built (run tools/scripts/setup.sh --no-demo)" >&2; exit 1; }
 mkdir -p "$out"
 IFS=, read -ra S <<< "$scenes"
 IFS=, read -ra M <<< "$methods"
@@ -41,6 +41,6 @@ for s in "${S[@]}"; do
     fi
   done
 done
-/usr/bin/python3 tools/matrix_table.py "$out" > "$out/table.md"
+/usr/bin/python3 tools/scripts/matrix_table.py "$out" > "$out/table.md"
 cat "$out/table.md"
 exit $status

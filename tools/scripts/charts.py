@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""tools/charts.py — draws the report's charts from the CSV/JSON the experiment programs
+"""tools/scripts/charts.py — draws the report's charts from the CSV/JSON the experiment programs
 write (Debian's python3-matplotlib; no other dependency).
 
-    /usr/bin/python3 tools/charts.py OUT_DIR    reads OUT_DIR/*.csv|json, writes OUT_DIR/*.png
-    /usr/bin/python3 tools/charts.py energy SUMMARY.json OUT.png
+    /usr/bin/python3 tools/scripts/charts.py OUT_DIR    reads OUT_DIR/*.csv|json, writes OUT_DIR/*.png
+    /usr/bin/python3 tools/scripts/charts.py energy SUMMARY.json OUT.png
                                                 the energy audit of one magsim-scene run
 
 Every chart is skipped (with a note) when its data file is missing, so a partial run still

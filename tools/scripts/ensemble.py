@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""tools/ensemble.py — one scene, several perturbed runs: the spread of its outcome.
+"""tools/scripts/ensemble.py — one scene, several perturbed runs: the spread of its outcome.
 
 A single run of a strongly magnetized pile is chaotic: removing one ball of 1032 can change
 how many of falling_magnet's balls are thrown off several times over (tools/findings/
@@ -13,9 +13,9 @@ those within 0.12 m of a magnet body over the last 0.5 s. From summary.json's se
 E = K + U_g + U* from 0.05 s on: "energy_rise", the most E ever stood above its running
 minimum (J), "energy_lost", E(0.05 s) - E(end) (J), and "rise_per_lost" their ratio.
 
-usage: /usr/bin/python3 tools/ensemble.py SCENE [--runs N] [--seconds S] [--base-count C]
-                                          [--out DIR] [--label L] [--jobs J]
-                                          [-- MAGSIM_SCENE_FLAGS...]
+usage: /usr/bin/python3 tools/scripts/ensemble.py SCENE [--runs N] [--seconds S] [--base-count C]
+                                                  [--out DIR] [--label L] [--jobs J]
+                                                  [-- MAGSIM_SCENE_FLAGS...]
   SCENE          a registry scene (balls_up, alphabets, falling_magnet, sakura_tree)
   --runs N       runs (default 6), N >= 1
   --seconds S    simulated seconds per run (default: 0.6)
@@ -192,10 +192,10 @@ def stats(values):
 
 def main():
     scene, opts, extra = parse(sys.argv[1:])
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     binary = os.environ.get("MAGSIM_SCENE_BIN") or os.path.join(root, "build", "release", "tools", "magsim-scene")
     if not os.access(binary, os.X_OK):
-        print(f"ensemble.py: {binary} not built (run tools/setup.sh --no-demo)", file=sys.stderr)
+        print(f"ensemble.py: {binary} not built (run tools/scripts/setup.sh --no-demo)", file=sys.stderr)
         return 1
     os.makedirs(opts["out"], exist_ok=True)
     rows = []
