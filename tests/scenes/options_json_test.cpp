@@ -1,4 +1,4 @@
-// tests/engine/options_json_test.cpp — the run options as JSON (scenes/options_json.cpp): the
+// tests/scenes/options_json_test.cpp — the run options as JSON (scenes/options_json.cpp): the
 // scene file reads the spelling summary.json and --write-scene write, a bad value names its
 // path, and the names of every enum round-trip through its one table. Each option's own round
 // trip: options_table_test.cpp.

@@ -1,4 +1,4 @@
-// tests/engine/scene_file_test.cpp — JSON scene files (scenes/scene_file.cpp): the
+// tests/scenes/scene_file_test.cpp — JSON scene files (scenes/scene_file.cpp): the
 // example loads and runs; bad files fail with the file and the JSON path in the message.
 #include "engine/simulation.hpp"
 #include "scenes/scene_file.hpp"
