@@ -1,7 +1,7 @@
-// tests/tools/reliability_limits_test.cpp — limits checked up front: one range per
+// tests/tools/cli/reliability_limits_test.cpp — limits checked up front: one range per
 // option shared by flag and scene file (and summary.json's options accepted back), the
 // memory a --count needs, and scene files parsed in linear time.
-#include "tests/tools/reliability.hpp"
+#include "tests/tools/cli/reliability.hpp"
 #include "engine/options_table.hpp"
 
 #include <catch2/catch.hpp>

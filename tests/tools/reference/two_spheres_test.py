@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""tests/tools/two_spheres_test.py — the exact two-sphere reference (tools/reference/
+"""tests/tools/reference/two_spheres_test.py — the exact two-sphere reference (tools/reference/
 two_spheres.py) against what it must satisfy: two of the reference values, the lone
 sphere, the dipole-dipole far field, the mu = inf bispherical solution, the translation
 formula summed directly, the boundary conditions and the force as a Maxwell-stress
@@ -14,7 +14,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..",
                                 "tools", "reference"))
 import two_spheres as ts  # noqa: E402
 

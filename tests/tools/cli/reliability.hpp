@@ -1,10 +1,10 @@
-// tests/tools/reliability.hpp — what the reliability tests of magsolve and magsim-scene
+// tests/tools/cli/reliability.hpp — what the reliability tests of magsolve and magsim-scene
 // share: running the programs (captured, or as a child with its own signals and a
 // time limit), scratch paths, file helpers and the address-space limit for runs that
 // must stay small. MAGSOLVE_BIN, MAGSIM_SCENE_BIN and MAGSIM_SOURCE_DIR come from CMake.
 #pragma once
 
-#include "tests/tools/run_command.hpp"
+#include "tests/tools/cli/run_command.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -38,7 +38,7 @@ using magsim::test::CommandResult;
 inline CommandResult scene(const std::string& args) { return magsim::test::run_command(MAGSIM_SCENE_BIN, args); }
 inline CommandResult solve(const std::string& args) { return magsim::test::run_command(MAGSOLVE_BIN, args); }
 
-inline std::string input(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tests/tools/inputs/" + name; }
+inline std::string input(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tests/tools/cli/inputs/" + name; }
 inline std::string example(const std::string& name) { return std::string(MAGSIM_SOURCE_DIR) + "/tools/examples/" + name; }
 
 inline std::string tmp(const std::string& name) { return magsim::test::scratch("reliability_" + name); }

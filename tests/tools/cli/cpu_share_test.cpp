@@ -1,6 +1,6 @@
-// tests/engine/cpu_share_test.cpp — the busy-machine thread count.
+// tests/tools/cli/cpu_share_test.cpp — the busy-machine thread count.
 #include "engine/simulation.hpp"
-#include "fixtures.hpp"
+#include "tests/engine/fixtures.hpp"
 #include "tools/cli/cpu_share.hpp"
 
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// tests/tools/run_command.hpp — runs a command line, capturing its output and exit code
+// tests/tools/cli/run_command.hpp — runs a command line, capturing its output and exit code
 // (for the tests of the command-line programs).
 #pragma once
 

@@ -1,4 +1,4 @@
-// tests/tools/reliability_test.cpp — "never a crash, never a silent success":
+// tests/tools/cli/reliability_test.cpp — "never a crash, never a silent success":
 // inputs that used to abort, segfault, run out of memory or exit 0 with nothing useful
 // done now end in a one-line error and the documented exit code (0 done, 1 bad input or
 // flags, 2 run failed, 3 I/O error).
@@ -6,7 +6,7 @@
 // This file: one-line errors and exit codes for bad input, bad flags and failed runs.
 // The others: reliability_system_test.cpp (FIFOs, signals, full disks, pipes, resource
 // limits) and reliability_limits_test.cpp (option ranges, memory, parsing time).
-#include "tests/tools/reliability.hpp"
+#include "tests/tools/cli/reliability.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,8 +1,8 @@
-// tests/tools/reliability_system_test.cpp — "never damage, never hang, never die on a
+// tests/tools/cli/reliability_system_test.cpp — "never damage, never hang, never die on a
 // signal": magsolve and magsim-scene against FIFOs and devices as input, deep or
 // NUL-terminated JSON, closed pipes, full disks and file size limits, symlinks and
 // FIFOs among the outputs, interrupting signals and a second run into a folder in use.
-#include "tests/tools/reliability.hpp"
+#include "tests/tools/cli/reliability.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
 // Tests for tools/cli/magsolve.cpp: the command line on good and bad input.
-#include "tests/tools/run_command.hpp"
+#include "tests/tools/cli/run_command.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

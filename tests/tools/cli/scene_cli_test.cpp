@@ -3,7 +3,7 @@
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
-#include "tests/tools/run_command.hpp"
+#include "tests/tools/cli/run_command.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
