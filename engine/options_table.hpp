@@ -3,7 +3,7 @@
 // (the member's own path, "magnetics.field.bh_theta"), the key files written before used
 // ("bh_theta"), its kind, unit, range, magsim-scene flag and one line of doc. Its default is
 // the struct's. The scene-file reader and writer (scenes/options_json.cpp), the range checks
-// (compile_model), magsim-scene's option flags (tools/option_flags.hpp), magsolve's flag ranges
+// (compile_model), magsim-scene's option flags (tools/cli/option_flags.hpp), magsolve's flag ranges
 // and summary.json's "options" all go through the table, so that an option is read, written,
 // checked and offered as a flag alike; tests/engine/options_table_test.cpp holds
 // scenes/SCENE_FILE.md to it.

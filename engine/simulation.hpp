@@ -80,9 +80,9 @@ class Simulation {
   /// OpenMP threads the next step's magnetics run with.
   int threads() const { return omp_threads_; }
   /// Caps the thread count the simulation chose itself (SimOptions::threads = 0) at n >= 1,
-  /// e.g. from a ThreadGovernor (cpu_share.hpp) on a busy machine; never raises it above that
-  /// choice, and an explicit SimOptions::threads is kept. States do not depend on it (the
-  /// kernels are bitwise the same for any thread count).
+  /// e.g. from a ThreadGovernor (tools/cli/cpu_share.hpp) on a busy machine; never raises it
+  /// above that choice, and an explicit SimOptions::threads is kept. States do not depend on
+  /// it (the kernels are bitwise the same for any thread count).
   void limit_default_threads(int n);
 
   /// Test hook of the safety check: the next step overwrites body i's linear velocity in

@@ -121,7 +121,7 @@ inline constexpr std::size_t kChunkF = 1024;
 /// MAGSIM_KERNEL=portable in the environment (read once, at the first field evaluation)
 /// forces the portable loops in any build, so that one CPU can run the path another CPU
 /// would; unset or any other value: AVX-512 where the CPU has it. (The command-line
-/// programs accept only unset, "auto" or "portable", tools/cli_common.hpp.) In a native
+/// programs accept only unset, "auto" or "portable", tools/cli/cli_common.hpp.) In a native
 /// build the rest of the code still uses the build CPU's instructions (FMA), so this
 /// reproduces a native build on a CPU without AVX-512, not the portable build.
 bool simd_kernel_active();

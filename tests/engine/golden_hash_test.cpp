@@ -59,9 +59,9 @@ std::string run_hash(const char* name, long steps, engine::SpaceKind space, int 
 // not x86-64 glibc) the test says so and checks nothing: FAIL would blame the change.
 // A change that alters results fails here. When the change is meant to alter them (a new
 // default, a fixed bug), say so in the commit, run this test in the native and the portable
-// build (tools/test.sh, tools/test.sh --portable) with MAGSIM_KERNEL unset and =portable, and
-// with GLIBC_TUNABLES as above, and copy the "now" hashes it prints into the tables; a
-// refactor must leave them as they are.
+// build (tools/scripts/test.sh, tools/scripts/test.sh --portable) with MAGSIM_KERNEL unset
+// and =portable, and with GLIBC_TUNABLES as above, and copy the "now" hashes it prints into
+// the tables; a refactor must leave them as they are.
 namespace {
 
 struct Golden {
@@ -137,7 +137,7 @@ TEST_CASE("golden state hashes: the five registry scenes after 100 steps", "[gol
 #else
   if (libm != Libm::Fma) {
     WARN("native build without libm's FMA variants: no golden hashes here; a build with "
-         "-DMAGSIM_NATIVE=OFF (tools/test.sh --portable) checks them on any x86-64 CPU");
+         "-DMAGSIM_NATIVE=OFF (tools/scripts/test.sh --portable) checks them on any x86-64 CPU");
   } else if (mag::detail::simd_kernel_active()) {
     check_hashes(kAvx512, "native build, AVX-512 kernels");
   } else {
@@ -145,7 +145,7 @@ TEST_CASE("golden state hashes: the five registry scenes after 100 steps", "[gol
     check_hashes(kNativeAvx2Fma, "native build (AVX2+FMA), portable kernels");
 #else
     WARN("native build without AVX2 and FMA: no golden hashes for its rounding; a build with "
-         "-DMAGSIM_NATIVE=OFF (tools/test.sh --portable) checks them on any x86-64 CPU");
+         "-DMAGSIM_NATIVE=OFF (tools/scripts/test.sh --portable) checks them on any x86-64 CPU");
 #endif
   }
 #endif

@@ -33,7 +33,8 @@ TEST_CASE("balls_up: the default lifts the pile onto the magnet and holds it, th
 
 TEST_CASE("balls_up at 3x strength with 20 QuickStep iterations keeps its pile: robustness corners",
           "[stability][balls_up][robustness]") {
-  // corners of tools/robustness.sh (1 s, ×3, 20 QuickStep iterations instead of the scene's 100)
+  // corners of tools/scripts/robustness.sh (1 s, ×3, 20 QuickStep iterations instead of the
+  // scene's 100)
   struct Corner {
     double w, dt;
   };

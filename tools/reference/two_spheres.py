@@ -60,7 +60,7 @@ with (a/r)^(n+1) P_n = a^(n+1) (-1)^n / n! d^n/dz^n (1/r) and
     axial:       Fz = -4 pi sum_k k E_k B_(k-1)
     transverse:  Fz = -2 pi sum_k (k+1) k (k-1) E_k B_(k-1)       (E, B of sphere 1).
 
-Independent checks (all in this file, run by tests/tools/two_spheres_test.py):
+Independent checks (all in this file, run by tests/tools/reference/two_spheres_test.py):
   * single sphere: moment 4 pi B_1 = 4 pi (mu - 1)/(mu + 2) (in H0 a^3);
   * far field: the dipole-dipole force of two such moments;
   * mu = inf, axial: the bispherical-coordinate solution (bispherical_moment): the pair's

@@ -1,0 +1,277 @@
+// tools/cli/magsim_scene/main.cpp — magsim-scene's command line: the flags, the scene they
+// name with their overrides applied (resolve_scene), --list, and the exit codes.
+#include "scenes/options_json.hpp"
+#include "scenes/registry.hpp"
+#include "scenes/scene_file.hpp"
+#include "tools/cli/magsim_scene/magsim_scene.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+
+#include <sys/resource.h>
+
+namespace magsim::scene_tool {
+
+namespace scenes = magsim::scenes;
+namespace fs = std::filesystem;
+
+std::string fmt(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+
+std::string registry_names() {
+  std::string names;
+  for (const scenes::SceneEntry& e : scenes::registry()) names += (names.empty() ? "" : ", ") + std::string(e.name);
+  return names;
+}
+
+
+MemoryNeed memory_need(const engine::SceneDesc& s) {
+  MemoryNeed n;
+  n.bodies = static_cast<double>(s.bodies.size());
+  for (const engine::BodyDesc& b : s.bodies) {
+    n.moments += static_cast<double>(b.moments.size());
+    n.shapes += static_cast<double>(b.shapes.size());
+  }
+  return n;
+}
+
+double memory_available(std::string* source) {
+  double avail = -1;
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    while (std::fgets(line, sizeof line, f)) {
+      unsigned long long kb = 0;
+      if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
+        avail = static_cast<double>(kb) * 1024.0;
+        *source = "MemAvailable";
+        break;
+      }
+    }
+    std::fclose(f);
+  }
+  struct rlimit rl {};
+  if (::getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+    double mapped = 0;  // VmSize: what the address-space limit already counts
+    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      unsigned long long kb = 0;
+      while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "VmSize: %llu kB", &kb) == 1) mapped = static_cast<double>(kb) * 1024.0;
+      std::fclose(f);
+    }
+    const double left = std::max(0.0, static_cast<double>(rl.rlim_cur) - mapped);
+    if (avail < 0 || left < avail) {
+      avail = left;
+      *source = "the address-space limit (ulimit -v)";
+    }
+  }
+  return avail;
+}
+
+void check_memory(const std::string& what, const MemoryNeed& need) {
+  std::string source;
+  const double avail = memory_available(&source);
+  const double gb = 1e9;
+  char detail[256];
+  std::snprintf(detail, sizeof detail, "%.0f bodies, %.0f moments, %.0f shapes", need.bodies, need.moments, need.shapes);
+  if (need.steps > 0) std::snprintf(detail + std::strlen(detail), sizeof detail - std::strlen(detail), ", %.0f steps", need.steps);
+  if (avail >= 0 && need.bytes() > avail) {
+    char msg[512];
+    std::snprintf(msg, sizeof msg, "%s: needs about %.2f GB of memory (%s; estimated, magsim_scene.hpp MemoryNeed), "
+                  "more than the %.2f GB available (%s)", what.c_str(), need.bytes() / gb, detail, avail / gb, source.c_str());
+    throw UsageError(msg);
+  }
+  if (need.bodies >= kProgressBodies)
+    std::fprintf(stderr, "%s: %s; about %.2f GB of memory estimated%s\n", what.c_str(), detail, need.bytes() / gb,
+                 avail >= 0 ? (", " + fmt(avail / gb) + " GB available").c_str() : "");
+}
+
+
+namespace {
+
+// registry scenes above this --count are sized from builds of 1 and of this many first
+constexpr int kSampleCount = 100;
+
+}  // namespace
+
+// The scene named on the command line, with the command line's overrides applied.
+engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
+  engine::SceneDesc s;
+  if (ends_with(a.scene, ".json")) {
+    if (app.count("--count")) throw UsageError("--count applies to registry scenes only, not to " + a.scene);
+    try {
+      std::error_code ec;
+      const auto bytes = fs::file_size(a.scene, ec);
+      if (!ec && bytes >= (32u << 20))  // a large file takes seconds: say what is going on
+        std::fprintf(stderr, "%s: reading %.0f MB of scene file\n", a.scene.c_str(), static_cast<double>(bytes) / 1e6);
+      s = scenes::load_scene_file(a.scene);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(e.what());
+    }
+    if (app.count("--strength"))
+      for (engine::BodyDesc& b : s.bodies)
+        for (engine::MomentDesc& m : b.moments)
+          if (m.permanent) m.moment *= a.strength;
+  } else {
+    const scenes::SceneEntry* e = scenes::find_scene(a.scene);
+    if (!e) throw UsageError("unknown scene '" + a.scene + "'; known: " + registry_names() + " (or a FILE.json)");
+    scenes::SceneParams p;
+    if (app.count("--count")) p.count = a.count;
+    if (app.count("--strength")) p.strength = a.strength;
+    if (p.count > kSampleCount) {
+      // the scene's own description would take memory in proportion to --count (1e8 balls:
+      // tens of GB before any check): its size is extrapolated from two small builds first
+      scenes::SceneParams small = p;
+      small.count = 1;
+      const MemoryNeed one = memory_need(e->build(small));
+      small.count = kSampleCount;
+      const MemoryNeed many = memory_need(e->build(small));
+      const double k = static_cast<double>(p.count - 1) / (kSampleCount - 1);
+      MemoryNeed need;
+      need.bodies = one.bodies + k * (many.bodies - one.bodies);
+      need.moments = one.moments + k * (many.moments - one.moments);
+      need.shapes = one.shapes + k * (many.shapes - one.shapes);
+      check_memory(a.scene + " --count " + std::to_string(p.count), need);
+    }
+    s = e->build(p);
+  }
+  // the option flags given (the table's: engine/options_table.hpp); the scene's values stand
+  // for the rest
+  try {
+    a.options.apply(&s.options);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  // the thread cap holds for the flag and the scene file alike (--write-scene too)
+  if (s.options.threads > tools::max_threads())
+    throw UsageError((app.count("--threads") ? std::string("--threads: ") : a.scene + ": options.threads: ") +
+                     "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
+                     std::to_string(tools::max_threads() / 4) + " cores), got " + std::to_string(s.options.threads));
+  return s;
+}
+
+
+namespace {
+
+// --seconds: a number > 0 that is also finite (PositiveNumber lets inf through)
+const auto kFinitePositive = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        const double x = std::stod(v);
+        if (std::isfinite(x) && x > 0) return {};
+      } catch (const std::exception&) {
+      }
+      return "must be a finite number > 0, got " + v;
+    },
+    "POSITIVE");
+
+// --width / --height: H.264 (tools/scripts/make_video.sh) needs even frame sizes
+const auto kEven = CLI::Validator(
+    [](std::string& v) -> std::string {
+      try {
+        if (std::stol(v) % 2 == 0) return {};
+      } catch (const std::exception&) {
+        return {};  // the Range check names it
+      }
+      return "must be even (H.264), got " + v;
+    },
+    "EVEN");
+
+}  // namespace
+
+}  // namespace magsim::scene_tool
+
+using namespace magsim::scene_tool;
+
+namespace tools = magsim::tools;
+
+int main(int argc, char** argv) {
+  tools::ignore_write_signals();
+  CLI::App app{"magsim-scene: run one scene with one method and write summary.json, states.csv and "
+               "moments.csv"};
+  Args a;
+  app.add_option("scene", a.scene, "a registry scene name (see --list) or a scene FILE.json");
+  auto* seconds = app.add_option("--seconds", a.seconds, "simulated time (s); default: the scene's")
+                      ->check(kFinitePositive);
+  auto* steps = app.add_option("--steps", a.steps, "number of rigid steps")->check(tools::Range(1L, static_cast<long>(kMaxSteps)));
+  seconds->excludes(steps);
+  steps->excludes(seconds);
+  app.add_option("--out", a.out, "output directory (default: out/<scene>_<method>)");
+  app.add_option("--fps", a.fps, "frames of simulated time per second to record (default 60), in [0.001, 1e9]")
+      ->check(tools::Range(1e-3, 1e9));
+  app.add_flag("--no-render", a.no_render, "do not render frames");
+  app.add_option("--width", a.width, "frame width in pixels (even, for H.264)")->check(tools::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--height", a.height, "frame height in pixels (even, for H.264)")->check(tools::Range(16, 8192) & kEven)->capture_default_str();
+  app.add_option("--samples", a.samples, "1: analytic sphere edges; 4: 2x2 supersampling (3x slower)")->check(tools::Range(1, 4))->capture_default_str();
+  app.add_flag("--arrows", a.arrows, "draw M1 (red) and M2 (blue) on every induced moment (on for crystal_balls)");
+  app.add_option("--count", a.count, "number of balls / letters (registry scenes)")->check(tools::Range(1, 1000000000));
+  app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(tools::PositiveNumber);
+  // the run options' flags, one per entry of the table that has one
+  a.options.add(&app, "Options of the run (each overrides the scene's options.<key>; the scene file's ranges)");
+  app.add_flag("--list", a.list, "list the registry's scenes and exit");
+  app.add_option("--write-scene", a.write_scene,
+                 "write the scene (with --count, --strength and the option flags applied) as a scene "
+                 "FILE.json to edit and run, and exit without running");
+
+  app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
+                                      "an output file could not be written",
+                                      "Runs longer than 1e7 rigid steps are refused; so are runs whose estimated memory exceeds "
+                                      "MemAvailable or what ulimit -v leaves, scene files that are not regular "
+                                      "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
+                                      std::string(tools::kMagsimKernelHelp) + "\n"
+                                      "Every option flag has the range of its scene-file key (engine/options_table.cpp).\n"
+                                      "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
+                                      "(summary.json: \"interrupted\": true) and exits 128 + the signal.\n"
+                                      "One run at a time per output folder (it holds a lock on DIR/.magsim.lock)."));
+  if (const int code = tools::parse_command_line(app, argc, argv, "error: "); code >= 0) return code;
+  if (const std::string e = tools::omp_num_threads_error(); !e.empty()) {
+    std::fprintf(stderr, "error: %s\n", e.c_str());
+    return kBadInput;
+  }
+  if (const std::string e = tools::magsim_kernel_error(); !e.empty()) {
+    std::fprintf(stderr, "error: %s\n", e.c_str());
+    return kBadInput;
+  }
+  if (a.list) {
+    errno = 0;
+    for (const scenes::SceneEntry& e : scenes::registry()) std::printf("%-16s %s\n", e.name, e.summary);
+    return tools::stdout_written("error: ", "the list") ? kOk : kIoError;
+  }
+  if (a.scene.empty()) {
+    std::fprintf(stderr, "error: name a scene (%s) or a FILE.json; --help for usage\n", registry_names().c_str());
+    return kBadInput;
+  }
+  // an empty name would be ignored (--write-scene) or fail as a folder (--out)
+  for (const auto& [flag, path] : {std::pair<const char*, const std::string&>{"--write-scene", a.write_scene}, {"--out", a.out}})
+    if (app.count(flag) && path.empty()) {
+      std::fprintf(stderr, "error: %s: needs a non-empty path\n", flag);
+      return kBadInput;
+    }
+  try {
+    if (app.count("--write-scene")) return write_scene(a, app);
+    return run(a, app);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "error: %s\n", tools::one_line(e.what()).c_str());
+    return kBadInput;
+  } catch (const IoError& e) {
+    std::fprintf(stderr, "error: %s\n", tools::one_line(e.what()).c_str());
+    return kIoError;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", tools::one_line(e.what()).c_str());
+    return kRunFailed;
+  }
+}

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# tools/scripts/test.sh — builds the test suite and runs it with CTest.
+#
+#   bash tools/scripts/test.sh            Release build in build/release, every test
+#   bash tools/scripts/test.sh --asan     ASan+UBSan build in build/asan (renderer off), portable
+#   bash tools/scripts/test.sh --portable Release build in build/portable, portable
+#   bash tools/scripts/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability)
+# Portable: -DMAGSIM_NATIVE=OFF, baseline x86-64 and the portable field kernels, whose golden
+# state hashes hold on every x86-64 CPU (tests/engine/golden_hash_test.cpp); the Release
+# build checks the AVX-512 ones where the CPU has AVX-512.
+# Installs the Debian packages first if any is missing (tools/scripts/setup.sh --deps-only).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+preset=release
+ctest_args=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --asan) preset=asan ;;
+    --portable) preset=portable ;;
+    --) shift; ctest_args=("$@"); break ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "test.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+bash tools/scripts/setup.sh --deps-only
+if [ "$preset" = asan ]; then
+  cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMAGSIM_SANITIZE=ON \
+        -DMAGSIM_RENDER=OFF -DMAGSIM_NATIVE=OFF >/dev/null
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+  export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+elif [ "$preset" = portable ]; then
+  cmake -S . -B build/portable -DCMAKE_BUILD_TYPE=Release -DMAGSIM_NATIVE=OFF >/dev/null
+else
+  cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
+fi
+cmake --build "build/$preset" -j"$(nproc)"
+ctest --test-dir "build/$preset" --output-on-failure -j"$(nproc)" "${ctest_args[@]}"
