@@ -5,6 +5,8 @@
 // Timings are figures to read, never pass/fail. --field-solver / --bh-theta / --bh-threshold
 // set the dipole-field summation of every run; the scaling runs use --scaling-solver (default
 // auto: Barnes–Hut from --bh-threshold moments on), or --field-solver when only that is given.
+// --near-field-cost measures every scene and method twice in the same run, with the near field
+// `dipole` and `pair`, and writes the ratio pair/dipole of T_i + T_f + T_r per step.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
 #include "tools/cli/field_flags.hpp"
@@ -68,7 +70,8 @@ struct Window {
 
 Window measure(const std::string& scene, mag::Method method, int count, int warmup, int steps,
                int threads, const magsim::tools::FieldFlags& field,
-               std::optional<mag::FieldSolver> solver = std::nullopt) {
+               std::optional<mag::FieldSolver> solver = std::nullopt,
+               std::optional<mag::NearField> near_field = std::nullopt) {
   magsim::scenes::SceneParams p;
   p.count = count;
   eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
@@ -76,6 +79,7 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   if (threads > 0) d.options.threads = threads;
   field.apply(&d.options.magnetics.field);
   if (solver) d.options.magnetics.field.solver = *solver;
+  if (near_field) d.options.magnetics.field.near_field.model = *near_field;
   eng::Simulation sim(d);
   Window w;
   w.moments = sim.model().nmoment;
@@ -143,6 +147,7 @@ int main(int argc, char** argv) {
   // today lands by t ≈ 0.3 s, and 500 leaves the window clear of the impact
   int warmup = 400, steps = 100, threads = 0, scaling_steps = 30, scaling_warmup = 500;
   std::string scaling_solver = "auto";
+  bool near_field_cost = false;
   magsim::tools::FieldFlags field;
   app.add_option("--scenes", scenes, "comma list of registry scenes")->capture_default_str();
   app.add_option("--methods", methods, "comma list of methods")->capture_default_str();
@@ -157,8 +162,15 @@ int main(int argc, char** argv) {
   app.add_option("--scaling-solver", scaling_solver,
                  "field solver of the scaling runs (default auto, or --field-solver when only that is given)")
       ->capture_default_str();
+  app.add_flag("--near-field-cost", near_field_cost,
+               "measure every scene and method twice, with --near-field dipole and pair, and print "
+               "the ratio pair/dipole of T_i + T_f + T_r per step (not with --near-field)");
   app.add_option("--json", out, "where to write the JSON")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (near_field_cost && field.near_opt->count()) {
+    std::fprintf(stderr, "bench: --near-field-cost measures both near fields; do not give --near-field with it\n");
+    return 2;
+  }
 
   // the scaling runs: --scaling-solver, or --field-solver when only that is given
   if (!app.count("--scaling-solver") && field.has_solver()) scaling_solver = field.solver;
@@ -202,31 +214,49 @@ int main(int argc, char** argv) {
   doc["bh_threshold"] = field.threshold;
   doc["runs"] = json::array();
   std::printf("%-15s %-15s %9s %9s %9s %9s %7s %6s %-10s   paper T_i/T_f/T_r (ms per frame)\n",
-              "scene", "method", "T_i", "T_f", "T_r", "total", "iters", "cap%", "solver");
+              "scene", near_field_cost ? "method/near" : "method", "T_i", "T_f", "T_r", "total", "iters", "cap%", "solver");
+  // the near fields of the Table 1 runs: the scene's (or --near-field's), or both
+  std::vector<std::optional<mag::NearField>> near_fields{std::nullopt};
+  if (near_field_cost) near_fields = {mag::NearField::Dipole, mag::NearField::Pair};
   for (const std::string& s : split(scenes)) {
     std::map<std::string, double> ti;  // method name → median T_i
     for (const auto& [name, m] : ms) {
-      const Window w = measure(s, m, 0, warmup, steps, threads, field);
-      json r = window_json(w);
-      r["scene"] = s;
-      r["method"] = name;
-      for (const PaperRow& p : kPaper) {
-        if (s != p.scene) continue;
-        const double* v = m == mag::Method::Kim2018 ? p.kim : p.ours;
-        r["paper_ms_per_frame"] = {{"T_i", v[0]}, {"T_f", v[1]}, {"T_r", v[2]}};
+      std::map<std::string, double> nf_total;  // near field → median T_i + T_f + T_r
+      for (const std::optional<mag::NearField>& nf : near_fields) {
+        const Window w = measure(s, m, 0, warmup, steps, threads, field, std::nullopt, nf);
+        json r = window_json(w);
+        r["scene"] = s;
+        r["method"] = name;
+        if (nf) {
+          r["near_field"] = mag::kNearFieldNames.name(*nf);
+          nf_total[r["near_field"].get<std::string>()] = w.total;
+        }
+        for (const PaperRow& p : kPaper) {
+          if (s != p.scene) continue;
+          const double* v = m == mag::Method::Kim2018 ? p.kim : p.ours;
+          r["paper_ms_per_frame"] = {{"T_i", v[0]}, {"T_f", v[1]}, {"T_r", v[2]}};
+        }
+        doc["runs"].push_back(r);
+        const std::string label = nf ? name + "/" + mag::kNearFieldNames.name(*nf) : name;
+        std::printf("%-15s %-15s %9.3f %9.3f %9.3f %9.3f %7.1f %5.0f%% %-10s", s.c_str(), label.c_str(),
+                    w.T_i, w.T_f, w.T_r, w.total, w.iters, 100 * w.cap_frac, w.solver.c_str());
+        if (r.contains("paper_ms_per_frame"))
+          std::printf("   %g / %g / %g", r["paper_ms_per_frame"]["T_i"].get<double>(),
+                      r["paper_ms_per_frame"]["T_f"].get<double>(),
+                      r["paper_ms_per_frame"]["T_r"].get<double>());
+        if (w.failed) std::printf("   FAILED: %s", w.error.c_str());
+        std::printf("\n%-15s %-15s T_r = collide %.3f + QuickStep %.3f ms (%d iterations, %.0f contacts)\n", "", "",
+                    w.collide, w.quickstep, w.quickstep_iterations, w.contacts);
+        std::fflush(stdout);
+        if (!nf || *nf == mag::NearField::Dipole) ti[name] = w.T_i;
       }
-      doc["runs"].push_back(r);
-      std::printf("%-15s %-15s %9.3f %9.3f %9.3f %9.3f %7.1f %5.0f%% %-10s", s.c_str(), name.c_str(),
-                  w.T_i, w.T_f, w.T_r, w.total, w.iters, 100 * w.cap_frac, w.solver.c_str());
-      if (r.contains("paper_ms_per_frame"))
-        std::printf("   %g / %g / %g", r["paper_ms_per_frame"]["T_i"].get<double>(),
-                    r["paper_ms_per_frame"]["T_f"].get<double>(),
-                    r["paper_ms_per_frame"]["T_r"].get<double>());
-      if (w.failed) std::printf("   FAILED: %s", w.error.c_str());
-      std::printf("\n%-15s %-15s T_r = collide %.3f + QuickStep %.3f ms (%d iterations, %.0f contacts)\n", "", "",
-                  w.collide, w.quickstep, w.quickstep_iterations, w.contacts);
-      std::fflush(stdout);
-      ti[name] = w.T_i;
+      if (nf_total.count("dipole") && nf_total["dipole"] > 0) {
+        const double ratio = nf_total["pair"] / nf_total["dipole"];
+        doc["near_field_cost"][s][name] = {{"dipole_total_ms", nf_total["dipole"]},
+                                           {"pair_total_ms", nf_total["pair"]},
+                                           {"pair_over_dipole", ratio}};
+        std::printf("%-15s %-15s T_i + T_f + T_r pair/dipole = %.3f (same run)\n", s.c_str(), name.c_str(), ratio);
+      }
     }
     // T_i of every method over Kim 2018's, measured in this run
     if (ti.count("kim2018") && ti["kim2018"] > 0) {

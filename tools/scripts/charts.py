@@ -342,6 +342,52 @@ def bench(out):
         plt.close(fig)
 
 
+def near_field_cost(out):
+    """bench --near-field-cost: T_i, T_f, T_r per step of each scene with one dipole per ball
+    and with the pair model, measured in the same run; the ratio pair/dipole over each pair of bars."""
+    p = have(out, "near_field_cost.json")
+    if not p:
+        return
+    with open(p) as f:
+        b = json.load(f)
+    runs = [r for r in b.get("runs", []) if "near_field" in r]
+    if not runs:
+        return
+    scenes = list(dict.fromkeys(r["scene"] for r in runs))
+    models = ("dipole", "pair")
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    width = 0.38
+    ymax = 0
+    for si, s in enumerate(scenes):
+        stacked = 0
+        for mi, m in enumerate(models):
+            r = next((r for r in runs if r["scene"] == s and r["near_field"] == m), None)
+            if not r:
+                continue
+            bottom = 0
+            for key, hatch in (("T_i", ""), ("T_f", "//"), ("T_r", "..")):
+                v = r["timing_ms"][key]["median"]
+                ax.bar(si + mi * width, v, width, bottom=bottom,
+                       color="tab:blue" if m == "dipole" else "tab:red", hatch=hatch,
+                       edgecolor="black", linewidth=0.3, label=f"{m} {key}" if si == 0 else None)
+                bottom += v
+            stacked = max(stacked, bottom)
+        ymax = max(ymax, stacked)
+        for meth, q in b.get("near_field_cost", {}).get(s, {}).items():
+            ax.text(si + width / 2, stacked * 1.02, f"pair/dipole ×{q['pair_over_dipole']:.2f}",
+                    ha="center", fontsize=8)
+    ax.set_ylim(0, ymax * 1.15)
+    ax.set_xticks([i + width / 2 for i in range(len(scenes))])
+    ax.set_xticklabels(scenes)
+    ax.set_ylabel("ms per 1 ms step (median)")
+    ax.set_title("near field: cost per step, dipole against pair (same run); T_i plain, T_f //, T_r ..",
+                 fontsize=9)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "near_field_cost.png"), dpi=110)
+    plt.close(fig)
+
+
 ENERGY_SERIES = (("energy_kinetic", "kinetic K", "tab:blue"),
                  ("energy_gravitational", "gravitational U_g − U_g(0)", "tab:brown"),
                  ("energy_magnetic_work", "magnetic work W_mag", "tab:red"),
@@ -427,7 +473,7 @@ def main():
     if not os.path.isdir(out):
         print(f"charts: {out} is not a directory", file=sys.stderr)
         sys.exit(2)
-    for f in (fig8, fig9, fig10, speed, snapshot_speed, tolerance, bench):
+    for f in (fig8, fig9, fig10, speed, snapshot_speed, tolerance, bench, near_field_cost):
         f(out)
     print(f"charts: written to {out}")
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # tools/scripts/report.sh — rebuilds the experiment report from scratch into out/report/: the paper's
 # Table 1 and Figs. 8, 9, 10, the uniqueness figure (§6.3), speed against accuracy (crystal_balls
-# and a sakura_tree snapshot), tolerance against force error, and scaling, as CSV/JSON + PNG
+# and a sakura_tree snapshot), tolerance against force error, scaling, and the near field
+# (two balls against exact magnetostatics; cost per step of dipole and pair, per scene), as CSV/JSON + PNG
 # charts + index.md. About 10–25 minutes on 2 cores.
 #
 #   bash tools/scripts/report.sh            reduced Fig. 9 grid (11 × 101 cells × 64 directions)
@@ -14,7 +15,7 @@ quick=0
 for a in "$@"; do
   case "$a" in
     --quick) quick=1 ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "report.sh: unknown option '$a' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -46,6 +47,9 @@ if [ -x $bin/bench_kernel ]; then
 fi
 echo "== two balls: dipole and pair model against exact magnetostatics"
 /usr/bin/python3 tools/reference/near_field_chart.py --out "$out" --magsolve $bin/magsolve | tee "$out/near_field.txt"
+echo "== near field: cost per step of dipole and pair, per scene"
+$bin/bench --scenes balls_up,falling_magnet,sakura_tree --methods anderson --scaling none --near-field-cost \
+    --json "$out/near_field_cost.json" | tee "$out/near_field_cost.txt"
 /usr/bin/python3 tools/scripts/charts.py "$out"
 /usr/bin/python3 tools/scripts/report_index.py "$out"
 echo "report: $out/index.md ($(( $(date +%s) - t0 )) s)"

@@ -279,6 +279,19 @@ def main():
     L.append("One dipole per ball against the exact linear two-sphere force (weak field) and the "
              "finite-element force (g = 0.003a, H0/Ms = 1e-4…10), for `--near-field dipole` and "
              "`pair` (tools/findings/near_field.md).\n")
+    nfc = load(out, "near_field_cost.json")
+    if nfc and nfc.get("near_field_cost"):
+        L.append(img(out, "near_field_cost.png", "near field cost"))
+        L.append("Cost per step of each near-field model, per scene, measured in the same run "
+                 f"(`bench --near-field-cost`, medians over {nfc.get('window_steps')} steps after "
+                 f"{nfc.get('warmup_steps')}):\n")
+        L.append("| scene | method | dipole (ms) | pair (ms) | pair / dipole |")
+        L.append("|---|---|---|---|---|")
+        for s, per in nfc["near_field_cost"].items():
+            for m, q in per.items():
+                L.append(f"| {s} | {m} | {q['dipole_total_ms']:.2f} | {q['pair_total_ms']:.2f} | "
+                         f"{q['pair_over_dipole']:.2f} |")
+        L.append("")
 
     L.append("## Speed against accuracy (beyond the paper)\n")
     L.append(img(out, "speed_accuracy.png", "speed against accuracy"))
