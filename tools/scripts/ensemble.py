@@ -9,7 +9,10 @@ reports per run and over the runs: escaped (beyond the scene's escape_radius, su
 run failed. From states.csv (recorded at --fps 20 unless the flags say otherwise), as
 frame-to-frame displacement over the frame time, of the pieces (bodies named ball_* or
 letter_*): "fastest_last_half", the fastest over the last 0.5 s, and "heap", the fastest of
-those within 0.12 m of a magnet body over the last 0.5 s. From summary.json's series, of
+those within 0.12 m of a magnet body over the last 0.5 s; "fastest_body", "fastest_at" and
+"fastest_from_magnet" name the piece that sets fastest_last_half, the time of the frame where
+it was that fast (s) and its distance from the nearest magnet body then (m; empty without
+one). From summary.json's series, of
 E = K + U_g + U* from 0.05 s on: "energy_rise", the most E ever stood above its running
 minimum (J), "energy_lost", E(0.05 s) - E(end) (J), and "rise_per_lost" their ratio.
 
@@ -39,6 +42,8 @@ import sys
 DEFAULT_COUNT = {"balls_up": 243, "alphabets": 100, "falling_magnet": 1032, "sakura_tree": 2500}
 FIGURES = ["escaped", "held", "max_speed_end", "max_speed_last_second", "fastest_last_half", "heap",
            "energy_rise", "energy_lost", "rise_per_lost", "guard_retakes", "substeps_mean"]
+# which piece sets fastest_last_half, when, and how far from a magnet: columns, not statistics
+WHO = ["fastest_body", "fastest_at", "fastest_from_magnet"]
 PIECE_PREFIXES = ("ball_", "letter_")
 HEAP_RADIUS = 0.12  # (m) "the heap": pieces this close to a magnet body
 LAST = 0.5          # (s) the window of fastest_last_half and heap
@@ -102,7 +107,8 @@ def parse(argv):
 
 
 def states_figures(path, magnets_hint=("magnet", "tip_magnet", "centre")):
-    """fastest_last_half and heap from states.csv (see the module's doc); None without frames."""
+    """fastest_last_half and heap from states.csv (see the module's doc), and a dict of WHO
+    (the piece that sets fastest_last_half); None, None, {} without frames."""
     frames = {}
     try:
         with open(path) as f:
@@ -115,12 +121,13 @@ def states_figures(path, magnets_hint=("magnet", "tip_magnet", "centre")):
                 p = (float(tail[1]), float(tail[2]), float(tail[3]))
                 frames.setdefault(fr, (t, {}))[1][name] = p
     except (OSError, ValueError, IndexError):
-        return None, None
+        return None, None, {}
     order = sorted(frames)
     if len(order) < 2:
-        return None, None
+        return None, None, {}
     t_end = frames[order[-1]][0]
     fastest = heap = 0.0
+    who = {k: None for k in WHO}
     for a, b in zip(order, order[1:]):
         ta, pa = frames[a]
         tb, pb = frames[b]
@@ -131,10 +138,13 @@ def states_figures(path, magnets_hint=("magnet", "tip_magnet", "centre")):
             if not n.startswith(PIECE_PREFIXES) or n not in pa:
                 continue
             v = math.dist(q, pa[n]) / (tb - ta)
-            fastest = max(fastest, v)
-            if magnets and min(math.dist(q, m) for m in magnets) <= HEAP_RADIUS:
+            d = min(math.dist(q, m) for m in magnets) if magnets else None
+            if v > fastest:
+                fastest = v
+                who = {"fastest_body": n, "fastest_at": tb, "fastest_from_magnet": d}
+            if d is not None and d <= HEAP_RADIUS:
                 heap = max(heap, v)
-    return fastest, heap
+    return fastest, heap, who
 
 
 def energy_figures(ser):
@@ -156,14 +166,14 @@ def row_of(count, summary_path, rc, log):
         s = json.load(open(summary_path))
     except (OSError, ValueError) as e:
         row["error"] = f"no summary.json ({e}); {log.strip().splitlines()[-1] if log.strip() else ''}"
-        for f in FIGURES:
+        for f in FIGURES + WHO:
             row[f] = None
         return row
     fin = s["final"]
     ser = s["series"]
     t_end = ser["time"][-1] if ser["time"] else 0.0
     last = [v for t, v in zip(ser["time"], ser["max_speed"]) if t >= t_end - 1.0 and v is not None]
-    fastest, heap = states_figures(os.path.join(os.path.dirname(summary_path), "states.csv"))
+    fastest, heap, who = states_figures(os.path.join(os.path.dirname(summary_path), "states.csv"))
     rise, lost, ratio = energy_figures(ser)
     sub = s.get("substeps", {})
     row.update({
@@ -180,7 +190,16 @@ def row_of(count, summary_path, rc, log):
         "max_speed_last_second": max(last) if last else None,
         "error": s.get("error"),
     })
+    row.update(who or {k: None for k in WHO})
     return row
+
+
+def who_text(r):
+    """' (ball_7 at 1.95 s, 0.085 m from a magnet)' for a row, '' when no piece moved."""
+    if not r.get("fastest_body"):
+        return ""
+    d = r["fastest_from_magnet"]
+    return f" ({r['fastest_body']} at {r['fastest_at']:.2f} s" + (f", {d:.3f} m from a magnet)" if d is not None else ")")
 
 
 def stats(values):
@@ -220,7 +239,7 @@ def main():
         r = row_of(count, os.path.join(d, "summary.json"), p.returncode, text)
         done[count] = r
         print(f"run (count {count}): escaped {r['escaped']}, held {r['held']}, fastest over the last "
-              f"{LAST} s {r['fastest_last_half']} m/s, heap {r['heap']} m/s, energy rise {r['energy_rise']} J "
+              f"{LAST} s {r['fastest_last_half']} m/s{who_text(r)}, heap {r['heap']} m/s, energy rise {r['energy_rise']} J "
               f"of {r['energy_lost']} J lost" + (f", error: {r['error']}" if r["error"] else ""), flush=True)
 
     import tempfile
@@ -236,10 +255,10 @@ def main():
         finish(running.pop(0))
     rows = [done[c] for c in counts]
     with open(os.path.join(opts["out"], "ensemble.csv"), "w") as f:
-        cols = ["count", "exit"] + FIGURES + ["error"]
+        cols = ["count", "exit"] + FIGURES + WHO + ["error"]
         f.write(",".join(cols) + "\n")
         for r in rows:
-            f.write(",".join("" if r[c] is None else json.dumps(r[c]) if c == "error" else str(r[c])
+            f.write(",".join("" if r[c] is None else json.dumps(r[c]) if c in ("error", "fastest_body") else str(r[c])
                              for c in cols) + "\n")
     summary = {"scene": scene, "label": opts["label"], "seconds": opts["seconds"], "runs": rows,
                "flags": flags, "stats": {f: stats([r[f] for r in rows]) for f in FIGURES},
