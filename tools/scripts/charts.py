@@ -291,6 +291,18 @@ def tolerance(out):
     plt.close(fig)
 
 
+def stacked_timing(ax, x, timing, width, color, label=None):
+    """One bar at x of a bench run's median T_i (plain), T_f (//) and T_r (..) stacked, labelled
+    "LABEL T_i" etc. when label is given; returns the bar's top."""
+    bottom = 0
+    for key, hatch in (("T_i", ""), ("T_f", "//"), ("T_r", "..")):
+        v = timing[key]["median"]
+        ax.bar(x, v, width, bottom=bottom, color=color, hatch=hatch, edgecolor="black", linewidth=0.3,
+               label=f"{label} {key}" if label else None)
+        bottom += v
+    return bottom
+
+
 def bench(out):
     p = have(out, "bench.json")
     if not p:
@@ -309,14 +321,7 @@ def bench(out):
             r = next((r for r in runs if r["scene"] == s and r["method"] == m), None)
             if not r:
                 continue
-            t = r["timing_ms"]
-            bottom = 0
-            for key, hatch in (("T_i", ""), ("T_f", "//"), ("T_r", "..")):
-                v = t[key]["median"]
-                ax.bar(si + mi * width, v, width, bottom=bottom, color=COLORS.get(m),
-                       hatch=hatch, edgecolor="black", linewidth=0.3,
-                       label=f"{m} {key}" if si == 0 else None)
-                bottom += v
+            stacked_timing(ax, si + mi * width, r["timing_ms"], width, COLORS.get(m), m if si == 0 else None)
     ax.set_xticks([i + 0.4 - width / 2 for i in range(len(scenes))])
     ax.set_xticklabels(scenes)
     ax.set_ylabel("ms per 1 ms step (median)")
@@ -364,14 +369,9 @@ def near_field_cost(out):
             r = next((r for r in runs if r["scene"] == s and r["near_field"] == m), None)
             if not r:
                 continue
-            bottom = 0
-            for key, hatch in (("T_i", ""), ("T_f", "//"), ("T_r", "..")):
-                v = r["timing_ms"][key]["median"]
-                ax.bar(si + mi * width, v, width, bottom=bottom,
-                       color="tab:blue" if m == "dipole" else "tab:red", hatch=hatch,
-                       edgecolor="black", linewidth=0.3, label=f"{m} {key}" if si == 0 else None)
-                bottom += v
-            stacked = max(stacked, bottom)
+            top = stacked_timing(ax, si + mi * width, r["timing_ms"], width,
+                                 "tab:blue" if m == "dipole" else "tab:red", m if si == 0 else None)
+            stacked = max(stacked, top)
         ymax = max(ymax, stacked)
         for meth, q in b.get("near_field_cost", {}).get(s, {}).items():
             ax.text(si + width / 2, stacked * 1.02, f"pair/dipole ×{q['pair_over_dipole']:.2f}",
