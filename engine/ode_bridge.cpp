@@ -330,7 +330,7 @@ struct OdeBridge::Impl {
     return mu * (z + std::sqrt(1.0 - z * z));
   }
 
-  int collide(std::vector<std::pair<int, int>>* pairs, double dt, double dt_soft) {
+  int collide(std::vector<std::pair<int, int>>* pairs, double dt, double dt_soft, double* max_depth) {
     ensure_thread_data();
     recs.clear();
     dSpaceCollide(space, this, &near_callback);
@@ -365,6 +365,7 @@ struct OdeBridge::Impl {
       }
     }
     dContact c;
+    double deepest = 0.0;
     for (const auto& [key, idx] : order) {
       const ContactRec& r = recs[idx];
       // rolling resistance where a ball rolls on the world (ground, static shapes), and,
@@ -387,6 +388,7 @@ struct OdeBridge::Impl {
         c.surface.motionN = d / dt;
       } else {
         c.geom.depth = d;
+        deepest = std::max(deepest, d);
       }
       dJointID j = dJointCreateContact(world, contact_group, &c);
       dJointAttach(j, dGeomGetBody(r.g.g1), dGeomGetBody(r.g.g2));
@@ -397,6 +399,7 @@ struct OdeBridge::Impl {
     }
     std::sort(pairs->begin(), pairs->end());
     pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
+    if (max_depth) *max_depth = deepest;
     return static_cast<int>(recs.size());
   }
 };
@@ -486,8 +489,9 @@ void OdeBridge::set_velocity(int i, const Vec3& v) {
   if (impl_->body[i]) dBodySetLinearVel(impl_->body[i], v.x(), v.y(), v.z());
 }
 
-int OdeBridge::collide(std::vector<std::pair<int, int>>* pairs, double h, double h_soft) {
-  return impl_->collide(pairs, h, h_soft > 0 ? h_soft : h);
+int OdeBridge::collide(std::vector<std::pair<int, int>>* pairs, double h, double h_soft,
+                       double* max_depth) {
+  return impl_->collide(pairs, h, h_soft > 0 ? h_soft : h, max_depth);
 }
 
 void OdeBridge::quickstep(unsigned long seed, double h) {

@@ -46,6 +46,10 @@ struct State {
   /// the next step's sub-steps (SimOptions::substep_load). Derived data as dvel: kept so that
   /// a restored state continues as the original; not part of the hash. Empty = zero.
   std::vector<double> mag_accel;
+  /// (m) the deepest overlap of any contact over the last step's collisions (each
+  /// sub-step's, at its start): how far bodies sank into contacts the solver left unbalanced.
+  /// Derived data kept for metrics; not part of the hash.
+  double contact_depth = 0.0;
   /// SimOptions::eddy_conductivity (eddy.cpp): the loss measures Ḃ as the change of each
   /// moment's flux density in its body's frame over the last ODE step. Derived data as dvel:
   /// kept so that a restored state continues as the original; not part of the hash.

@@ -94,6 +94,7 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
     if (inject_body_ >= 0) ode_->set_velocity(inject_body_, inject_velocity_);
     mz = state_.mag;
     next.eddy = state_.eddy;
+    next.contact_depth = 0.0;
     place_moments(m, state_, &moments_, &mz);
   }
 
@@ -134,7 +135,9 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
       {
         ScopedTimer c(&prof.collide_ms);
         ode_->update_margins(now, ws_.body_force, h);
-        prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft);
+        double depth = 0.0;
+        prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth);
+        next.contact_depth = std::max(next.contact_depth, depth);
       }
       ScopedTimer q(&prof.quickstep_ms);
       try {

@@ -319,6 +319,37 @@ TEST_CASE("step: the magnetic load splits the frames of a body pressed into its 
   }
 }
 
+TEST_CASE("step: State::contact_depth is the deepest overlap the step's collision found", "[step]") {
+  // A sphere placed 0.2 mm into the ground plane: its first collision reads that overlap,
+  // less than the contact margin's growth; a sphere 1 mm above it reads none (a speculative
+  // gap is not an overlap).
+  const double r = 0.01, d0 = 2e-4;
+  SceneDesc s;
+  s.options.threads = 1;
+  BodyDesc b;
+  b.name = "sphere";
+  b.shapes.push_back({ShapeKind::Sphere, Vec3::Zero(), Quat::Identity(), Vec3(r, r, r)});
+  SECTION("sunk 0.2 mm") {
+    b.position = Vec3(0, 0, r - d0);
+    s.bodies.push_back(b);
+    engine::Simulation sim(s);
+    CHECK(sim.state().contact_depth == 0.0);  // nothing collided yet
+    sim.step();
+    CHECK(sim.state().contact_depth == Approx(d0).epsilon(1e-9));
+    sim.run(200);  // the error reduction pushes it out
+    CHECK(sim.state().contact_depth < 0.1 * d0);
+  }
+  SECTION("1 mm above") {
+    b.position = Vec3(0, 0, r + 1e-3);
+    s.options.gravity = Vec3::Zero();
+    s.bodies.push_back(b);
+    engine::Simulation sim(s);
+    sim.step();
+    REQUIRE(sim.last_profile().contacts >= 1);  // the speculative contact is there
+    CHECK(sim.state().contact_depth == 0.0);
+  }
+}
+
 TEST_CASE("step: a box corner a gap away from a sphere reads as a gap, not a penetration", "[step]") {
   // A box's contact margin μ grows its half extents, so along its body diagonal the grown
   // box reaches √3 μ beyond the corner (ode_bridge.cpp, margin_along). Read as μ, the corner

@@ -45,6 +45,13 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
   CHECK(j["final"]["escaped"] == 0);  // 3 ms: nothing has left the pile
   CHECK(j["series"]["held"].size() == j["series"]["attached"].size());
   CHECK(j["series"]["escaped"].size() == j["series"]["time"].size());
+  // the deepest contact overlap: over every step, so at least that of any recorded frame
+  REQUIRE(j["series"]["contact_depth"].size() == j["series"]["time"].size());
+  double framed = 0.0;
+  for (const auto& v : j["series"]["contact_depth"]) framed = std::max(framed, v.get<double>());
+  CHECK(j["contact_depth"]["max"].get<double>() >= framed);
+  CHECK(j["contact_depth"]["max"].get<double>() < 0.005);  // less than a ball's radius
+  CHECK(j["contact_depth"]["max_at"].get<double>() <= 0.003 + 1e-12);
   // the energy audit: final values and per-frame series; its books balance
   const auto& e = j["energy"];
   CHECK(e["substeps"] == 3);

@@ -131,6 +131,7 @@ class Recorder {
     series_["momentum_norm"].push_back(x.momentum.norm());
     series_["contacts"].push_back(x.contacts);
     series_["substeps"].push_back(sim_.last_profile().substeps);
+    series_["contact_depth"].push_back(sim_.state().contact_depth);  // the deepest overlap (m)
     series_["threads"].push_back(sim_.threads());
     check();
     // the energy audit (engine/energy.hpp): state functions and cumulative work (J), and the
