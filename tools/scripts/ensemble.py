@@ -108,7 +108,7 @@ def parse(argv):
 
 def states_figures(path, magnets_hint=("magnet", "tip_magnet", "centre")):
     """fastest_last_half and heap from states.csv (see the module's doc), and a dict of WHO
-    (the piece that sets fastest_last_half); None, None, {} without frames."""
+    (the piece that sets fastest_last_half); None, None and WHO all None without frames."""
     frames = {}
     try:
         with open(path) as f:
@@ -121,10 +121,10 @@ def states_figures(path, magnets_hint=("magnet", "tip_magnet", "centre")):
                 p = (float(tail[1]), float(tail[2]), float(tail[3]))
                 frames.setdefault(fr, (t, {}))[1][name] = p
     except (OSError, ValueError, IndexError):
-        return None, None, {}
+        return None, None, dict.fromkeys(WHO)
     order = sorted(frames)
     if len(order) < 2:
-        return None, None, {}
+        return None, None, dict.fromkeys(WHO)
     t_end = frames[order[-1]][0]
     fastest = heap = 0.0
     who = {k: None for k in WHO}
@@ -190,7 +190,7 @@ def row_of(count, summary_path, rc, log):
         "max_speed_last_second": max(last) if last else None,
         "error": s.get("error"),
     })
-    row.update(who or {k: None for k in WHO})
+    row.update(who)
     return row
 
 

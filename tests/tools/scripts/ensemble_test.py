@@ -61,7 +61,9 @@ class Figures(unittest.TestCase):
 
     def test_one_frame_has_no_figures(self):
         path = write_states([(0, 0.0, "magnet", (0, 0, 0)), (0, 0.0, "ball_0", (0.1, 0, 0))])
-        self.assertEqual(ensemble.states_figures(path), (None, None, {}))
+        # the row's WHO columns are filled (empty) all the same
+        self.assertEqual(ensemble.states_figures(path),
+                         (None, None, {"fastest_body": None, "fastest_at": None, "fastest_from_magnet": None}))
 
     def test_still_pieces_name_no_one(self):
         rows = [(fr, fr * 0.05, n, p) for fr in range(5)
