@@ -221,7 +221,7 @@ int main(int argc, char** argv) {
   for (const std::string& s : split(scenes)) {
     std::map<std::string, double> ti;  // method name → median T_i
     for (const auto& [name, m] : ms) {
-      std::map<std::string, double> nf_total;  // near field → median T_i + T_f + T_r
+      std::map<mag::NearField, double> nf_total;  // near field → median T_i + T_f + T_r
       for (const std::optional<mag::NearField>& nf : near_fields) {
         const Window w = measure(s, m, 0, warmup, steps, threads, field, std::nullopt, nf);
         json r = window_json(w);
@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
         r["method"] = name;
         if (nf) {
           r["near_field"] = mag::kNearFieldNames.name(*nf);
-          nf_total[r["near_field"].get<std::string>()] = w.total;
+          nf_total[*nf] = w.total;
         }
         for (const PaperRow& p : kPaper) {
           if (s != p.scene) continue;
@@ -250,10 +250,11 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         if (!nf || *nf == mag::NearField::Dipole) ti[name] = w.T_i;
       }
-      if (nf_total.count("dipole") && nf_total["dipole"] > 0) {
-        const double ratio = nf_total["pair"] / nf_total["dipole"];
-        doc["near_field_cost"][s][name] = {{"dipole_total_ms", nf_total["dipole"]},
-                                           {"pair_total_ms", nf_total["pair"]},
+      const auto dipole = nf_total.find(mag::NearField::Dipole), pair = nf_total.find(mag::NearField::Pair);
+      if (dipole != nf_total.end() && pair != nf_total.end() && dipole->second > 0) {
+        const double ratio = pair->second / dipole->second;
+        doc["near_field_cost"][s][name] = {{"dipole_total_ms", dipole->second},
+                                           {"pair_total_ms", pair->second},
                                            {"pair_over_dipole", ratio}};
         std::printf("%-15s %-15s T_i + T_f + T_r pair/dipole = %.3f (same run)\n", s.c_str(), name.c_str(), ratio);
       }
