@@ -20,7 +20,7 @@ while [ $# -gt 0 ]; do
     --methods) methods="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --no-render) render=(--no-render); shift ;;
-    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "scene_matrix.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
