@@ -14,8 +14,9 @@ namespace {
 // `held` (skip_grounded = true): a body that touches the ground (a contact pair with −1) is
 // supported by the floor, not held by the magnet, so it is neither counted nor walked
 // through. Magnet bodies are the seeds, whether or not they touch the ground themselves.
-int count_reachable(const Model& m, const State& s, bool skip_grounded) {
-  if (s.contact_pairs.empty()) return 0;
+std::vector<int> reachable(const Model& m, const State& s, bool skip_grounded) {
+  std::vector<int> found;
+  if (s.contact_pairs.empty()) return found;
   std::vector<std::vector<int>> adj(m.nbody);
   std::vector<std::uint8_t> grounded(m.nbody, 0);
   for (const auto& [a, b] : s.contact_pairs) {
@@ -33,16 +34,15 @@ int count_reachable(const Model& m, const State& s, bool skip_grounded) {
       seen[b] = 1;
       queue.push_back(b);
     }
-  int count = 0;
   for (std::size_t head = 0; head < queue.size(); ++head) {
     for (int nb : adj[queue[head]]) {
       if (seen[nb] || grounded[nb] || m.body_type[nb] != BodyType::Dynamic) continue;
       seen[nb] = 1;
-      ++count;
+      found.push_back(nb);
       queue.push_back(nb);
     }
   }
-  return count;
+  return found;
 }
 
 // Dynamic non-magnet bodies farther than R_esc from c, the centroid of the magnet bodies:
@@ -114,8 +114,10 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
     for (int b : m.dynamic_bodies)
       if (!m.body_magnet[b]) r.magnet_radius = std::max(r.magnet_radius, (s.pos[b] - s.pos[mb]).norm());
   }
-  r.attached = count_reachable(m, s, false);
-  r.held = count_reachable(m, s, true);
+  r.attached = static_cast<int>(reachable(m, s, false).size());
+  const std::vector<int> held = reachable(m, s, true);
+  r.held = static_cast<int>(held.size());
+  for (int b : held) r.held_max_speed = std::max(r.held_max_speed, s.vel[b].norm());
   r.escaped = static_cast<int>(find_escaped(m, s).size());
   return r;
 }

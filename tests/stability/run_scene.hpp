@@ -18,6 +18,9 @@ struct SceneRun {
   /// the same over the bodies not escaped (Metrics::escaped) at each sample: what is left
   /// around the magnet, without the few thrown off that slide on for ever (m/s)
   double tail_max_speed_inside = 0;
+  /// the same over the bodies the engine counts as held (Metrics::held_max_speed): the
+  /// lifted pile, without the balls on the floor (m/s)
+  double tail_max_speed_held = 0;
   double tail_max_ke = 0;        ///< max kinetic energy over the trailing window (J)
   double max_speed = 0;          ///< over the whole run (m/s)
   double max_bounding_radius = 0;
@@ -71,6 +74,7 @@ inline SceneRun run_scene(const std::string& name, mag::Method method, double se
       if (k >= tail_from) {
         r.tail_max_speed = std::max(r.tail_max_speed, m.max_speed);
         r.tail_max_speed_inside = std::max(r.tail_max_speed_inside, speed_inside(sim));
+        r.tail_max_speed_held = std::max(r.tail_max_speed_held, m.held_max_speed);
         r.tail_max_ke = std::max(r.tail_max_ke, m.kinetic_energy);
         r.min_attached_tail = std::min(r.min_attached_tail, m.attached);
       }
