@@ -32,6 +32,7 @@
 // State::eddy, so a restored state, or a step retaken after a rollback, measures Ḃ as the
 // uninterrupted run does.
 #include "engine/stages.hpp"
+#include "magnetics/det_math.hpp"
 
 #include "magnetics/curves.hpp"
 #include "magnetics/types.hpp"
@@ -52,7 +53,7 @@ Mat3 cross_matrix(const Vec3& u) {
 }  // namespace
 
 double eddy_coefficient(double conductivity, double volume) {
-  const double a = std::cbrt(3.0 * volume / (4.0 * mag::kPi));
+  const double a = mag::dmath::cbrt(3.0 * volume / (4.0 * mag::kPi));
   return conductivity * a * a * volume / 10.0;
 }
 

@@ -4,6 +4,7 @@
 // tensors, shape and moment offsets in the COM frame, and which moment belongs to which
 // body. Validation happens here too, so the step can assume finite, positive inputs.
 #include "engine/model.hpp"
+#include "magnetics/det_math.hpp"
 
 #include "engine/limits.hpp"
 #include "engine/options_table.hpp"
@@ -196,7 +197,7 @@ double shape_bounding_radius(ShapeKind kind, const Vec3& size) {
     case ShapeKind::Sphere: return size.x();
     case ShapeKind::Box: return size.norm();
     case ShapeKind::Capsule: return size.x() + size.y();
-    case ShapeKind::Cylinder: return std::hypot(size.x(), size.y());
+    case ShapeKind::Cylinder: return mag::dmath::hypot(size.x(), size.y());
   }
   return 0.0;
 }
@@ -337,7 +338,7 @@ Model compile_model(const SceneDesc& scene) {
       m.moment_volume.push_back(md.volume);
       m.moment_Ms.push_back(md.permanent ? 0.0 : md.Ms);
       m.moment_m.push_back(md.permanent ? md.moment : Vec3::Zero());
-      m.moment_radius.push_back(std::cbrt(3.0 * md.volume / (4.0 * kPi)));
+      m.moment_radius.push_back(mag::dmath::cbrt(3.0 * md.volume / (4.0 * kPi)));
       m.moment_interaction_radius.push_back(
           md.interaction_radius >= 0 ? md.interaction_radius : inscribed_radius(b.shapes, md.offset));
       if (!md.permanent) ++m.induced_count;

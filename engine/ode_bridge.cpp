@@ -4,6 +4,7 @@
 // Simulation (no globals but the library's init refcount) and turns the Model into ODE
 // objects once; afterwards it only moves state in and out, collides and steps.
 #include "engine/ode_bridge.hpp"
+#include "magnetics/det_math.hpp"
 
 #include <ode/ode.h>
 
@@ -170,8 +171,8 @@ struct OdeBridge::Impl {
   void set_damping(double h) {
     if (h == damped_h) return;
     const SimOptions& o = model.options;
-    dWorldSetLinearDamping(world, 1.0 - std::exp(-o.linear_damping * h));
-    dWorldSetAngularDamping(world, 1.0 - std::exp(-o.angular_damping * h));
+    dWorldSetLinearDamping(world, 1.0 - mag::dmath::exp(-o.linear_damping * h));
+    dWorldSetAngularDamping(world, 1.0 - mag::dmath::exp(-o.angular_damping * h));
     damped_h = h;
   }
 

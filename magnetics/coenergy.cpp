@@ -1,5 +1,6 @@
 // magnetics/coenergy.cpp — the co-energy U* (formulas in coenergy.hpp).
 #include "magnetics/coenergy.hpp"
+#include "magnetics/det_math.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,8 +16,8 @@ double curve_energy_density(Curve c, double Mnorm, double Ms) {
     const double x2 = x * x;
     return Ms * Ms / 6.0 * x2 * (1.0 + x2 / 6.0);
   }
-  const double tail = x < 1.0 ? (1.0 - x) * std::log1p(-x) : 0.0;  // (1 − x) ln(1 − x) → 0
-  return Ms * Ms / 6.0 * ((1.0 + x) * std::log1p(x) + tail);
+  const double tail = x < 1.0 ? (1.0 - x) * dmath::log1p(-x) : 0.0;  // (1 − x) ln(1 − x) → 0
+  return Ms * Ms / 6.0 * ((1.0 + x) * dmath::log1p(x) + tail);
 }
 
 // U* = μ0 Σ_induced V Ψ(M) − ½ μ0 Σ m·(H − H0) − μ0 Σ m·H0

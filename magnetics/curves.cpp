@@ -1,5 +1,6 @@
 // magnetics/curves.cpp — the smooth (eq. 10) and non-smooth (eq. 7) magnetization curves.
 #include "magnetics/curves.hpp"
+#include "magnetics/det_math.hpp"
 
 #include <cmath>
 #include <limits>
@@ -11,7 +12,7 @@ namespace {
 // tanh(x)/x, with its series near 0 (relative error < 1e-16 for x < 1e-4)
 double tanh_over_x(double x) {
   if (x < 1e-4) return 1.0 - x * x / 3.0;
-  return std::tanh(x) / x;
+  return dmath::tanh(x) / x;
 }
 
 }  // namespace
@@ -36,7 +37,7 @@ Mat3 curve_dMdH(Curve c, const Vec3& H, double Ms) {
     const double x = 3.0 * h / Ms;
     const double g_over_h = 3.0 * tanh_over_x(x);
     if (h == 0.0) return g_over_h * I;
-    const double sech = 1.0 / std::cosh(x);
+    const double sech = 1.0 / dmath::cosh(x);
     const double gp = 3.0 * sech * sech;
     const Vec3 u = H / h;
     const Mat3 P = u * u.transpose();
@@ -51,7 +52,7 @@ Mat3 curve_dMdH(Curve c, const Vec3& H, double Ms) {
 double tanh_inverse_norm(double Mnorm, double Ms) {
   const double x = Mnorm / Ms;
   if (x >= 1.0) return std::numeric_limits<double>::infinity();
-  return Ms / 3.0 * std::atanh(x);
+  return Ms / 3.0 * dmath::atanh(x);
 }
 
 // eq. 11: γ_C = |f⁻¹(M)|/|M| = atanh(x)/(3x), bounded above by gamma_max
@@ -59,7 +60,7 @@ double gamma_c(double x, double gamma_max) {
   if (x >= 1.0) return gamma_max;
   double g;
   if (x < 1e-4) g = (1.0 + x * x / 3.0) / 3.0;  // atanh(x)/x = 1 + x²/3 + …
-  else g = std::atanh(x) / (3.0 * x);
+  else g = dmath::atanh(x) / (3.0 * x);
   return g < gamma_max ? g : gamma_max;
 }
 

@@ -57,7 +57,7 @@ enum class PairTerms { H, HJ };
 /// Adds to H[0..2] the field (eq. 1) at t of every source in v except t's own, and with
 /// PairTerms::HJ to J[0..5] (xx, yy, zz, xy, xz, yz) the Jacobian of those not in t's group.
 /// Softened with eps2 = ε². Results in A/m (A/m²). Dispatches to AVX-512 where the CPU has
-/// it, else a portable loop; the sum order is fixed, so results are deterministic.
+/// it, else portable lanes; both give the same bits (simd.hpp).
 ///
 /// Bounded pairs (v.rad != nullptr): a pair closer than R = a_i + a_t is evaluated at the
 /// separation R along its own direction, r → r·R/|r| (field and Jacobian alike), so an
@@ -103,9 +103,9 @@ struct TargetF {
 /// sum_pairs; the Jacobian without the
 /// target's group; never the target itself), each source evaluated in float, summed per
 /// lane in float over at most kChunkF sources and then in double (so the rounding of the
-/// sum stays ~1e-7 relative to Σ|terms| however long the list). AVX-512 (16 lanes) when
-/// simd_kernel_active(), else a portable loop with the same algebra (the two agree to float
-/// rounding, not bitwise); each is deterministic (fixed order). Results added to H, J as
+/// sum stays ~1e-7 relative to Σ|terms| however long the list). AVX-512 when
+/// simd_kernel_active(), else portable lanes: 16 float lanes either way, the same bits
+/// (simd.hpp). Results added to H, J as
 /// sum_pairs does. Assumes separations ≫ 1e-5 m (or a softening): 1/|r|⁷ must not overflow.
 void sum_pairs_f32(const SourceViewF& v, const TargetF& t, float eps2, PairTerms terms,
                    double* H, double* J);
@@ -121,9 +121,8 @@ inline constexpr std::size_t kChunkF = 1024;
 /// MAGSIM_KERNEL=portable in the environment (read once, at the first field evaluation)
 /// forces the portable loops in any build, so that one CPU can run the path another CPU
 /// would; unset or any other value: AVX-512 where the CPU has it. (The command-line
-/// programs accept only unset, "auto" or "portable", tools/cli/cli_common.hpp.) In a native
-/// build the rest of the code still uses the build CPU's instructions (FMA), so this
-/// reproduces a native build on a CPU without AVX-512, not the portable build.
+/// programs accept only unset, "auto" or "portable", tools/cli/cli_common.hpp.) The two
+/// paths give the same bits; the choice changes speed only.
 bool simd_kernel_active();
 /// Switches the AVX-512 path off (false) or back on, for tests and benchmarks that compare
 /// it with the portable loop; "on" cannot override MAGSIM_KERNEL=portable. Not to be called

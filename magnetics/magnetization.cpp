@@ -5,6 +5,7 @@
 // All moments update from the fields of the previous iterate, so a sweep is one parallel
 // loop after one field evaluation.
 #include "magnetics/magnetization.hpp"
+#include "magnetics/det_math.hpp"
 
 #include "magnetics/anderson.hpp"
 #include "magnetics/curves.hpp"
@@ -50,22 +51,22 @@ std::string validate(const DynamicsOptions& o) {
 double advance_theta(double theta, double c_dt, ThetaIntegrator integ) {
   if (!(c_dt > 0)) return theta;
   if (integ == ThetaIntegrator::Euler) {
-    const double Th = theta < kHalfPi ? std::sin(theta) : 2.0 - std::sin(theta);
+    const double Th = theta < kHalfPi ? dmath::sin(theta) : 2.0 - dmath::sin(theta);
     return std::max(0.0, theta - c_dt * Th);
   }
   if (theta > kHalfPi) {
-    const double s = std::sin(0.5 * theta), co = std::cos(0.5 * theta);
-    const double G = 2.0 / kSqrt3 * std::atan2(2.0 * s - co, kSqrt3 * co);
+    const double s = dmath::sin(0.5 * theta), co = dmath::cos(0.5 * theta);
+    const double G = 2.0 / kSqrt3 * dmath::atan2(2.0 * s - co, kSqrt3 * co);
     const double G_half = 2.0 / kSqrt3 * (kPi / 6.0);
     if (G - c_dt > G_half) {
       const double Gn = G - c_dt;
-      const double u = 0.5 * (kSqrt3 * std::tan(0.5 * kSqrt3 * Gn) + 1.0);
-      return 2.0 * std::atan(u);
+      const double u = 0.5 * (kSqrt3 * dmath::tan(0.5 * kSqrt3 * Gn) + 1.0);
+      return 2.0 * dmath::atan(u);
     }
     c_dt -= G - G_half;
     theta = kHalfPi;
   }
-  return 2.0 * std::atan(std::tan(0.5 * theta) * std::exp(-c_dt));
+  return 2.0 * dmath::atan(dmath::tan(0.5 * theta) * dmath::exp(-c_dt));
 }
 
 // eq. 11 (ours, damping-only LLG): H_eff = H − γ_C M, γ_C = min(atanh(x)/(3x), γ_max);
@@ -78,7 +79,7 @@ Vec3 effective_field(Method method, const DynamicsOptions& opt, const Vec3& H, c
     // the bound never below γ_C at the solution, |H|/|f(H)| = (|H|/Ms)/tanh(3|H|/Ms),
     // so the fixed point H_eff = 0 ⇔ M = f(H) is kept exactly
     const double h = H.norm() / Ms;
-    const double g_sol = h > 1e-4 ? h / std::tanh(3.0 * h) : (1.0 + 3.0 * h * h) / 3.0;
+    const double g_sol = h > 1e-4 ? h / dmath::tanh(3.0 * h) : (1.0 + 3.0 * h * h) / 3.0;
     // measured stability limit of the raised bound: k·γ ≤ 2, k = β Δt Ms (magnetics/PHYSICS.md)
     const double cap = std::min(opt.adaptive_gamma_cap, 2.0 / (opt.beta * opt.dt * Ms));
     if (g_sol <= cap) bound = std::max(bound, g_sol);
@@ -125,15 +126,15 @@ void rotate_toward(const Vec3& h_hat, double c_dt, double Ms, ThetaIntegrator in
       // sin θ / (1 + cos θ), τ' = τ e^{−cΔt}, cos θ' = (1 − τ'²)/(1 + τ'²),
       // sin θ' = 2τ'/(1 + τ'²)
       if (!(c_dt > 0)) return;
-      const double tau = sin_t / (1.0 + cos_t) * std::exp(-c_dt);
+      const double tau = sin_t / (1.0 + cos_t) * dmath::exp(-c_dt);
       const double tau2 = tau * tau, inv = 1.0 / (1.0 + tau2);
       *Mk = Ms * (((1.0 - tau2) * inv) * h_hat + (2.0 * tau * inv) * e);
       return;
     }
   }
-  const double theta = std::atan2(sin_t, cos_t);
+  const double theta = dmath::atan2(sin_t, cos_t);
   const double th = advance_theta(theta, c_dt, integ);
-  *Mk = Ms * (std::cos(th) * h_hat + std::sin(th) * e);
+  *Mk = Ms * (dmath::cos(th) * h_hat + dmath::sin(th) * e);
 }
 
 // LLG (eq. 6) explicit step with γ scaled so that γα Ms/(1+α²) = β (magnetics/PHYSICS.md):
@@ -153,14 +154,14 @@ void llg_step(bool precession, const DynamicsOptions& opt, double Ms, const Vec3
 void keep_pair_apart(double Ms, double phi_min, Vec3* M1, Vec3* M2) {
   const Vec3 d = *M1 - *M2;
   const double dn = d.norm();
-  if (dn >= 2.0 * Ms * std::sin(phi_min)) return;
+  if (dn >= 2.0 * Ms * dmath::sin(phi_min)) return;
   Vec3 u = *M1 + *M2;
   const double un = u.norm();
   u = un > 0 ? Vec3(u / un) : Vec3::UnitZ();
   Vec3 w = d - d.dot(u) * u;
   w = w.norm() > 1e-3 * dn && dn > 0 ? Vec3(w.normalized()) : any_perpendicular(u);
-  *M1 = Ms * (std::cos(phi_min) * u + std::sin(phi_min) * w);
-  *M2 = Ms * (std::cos(phi_min) * u - std::sin(phi_min) * w);
+  *M1 = Ms * (dmath::cos(phi_min) * u + dmath::sin(phi_min) * w);
+  *M2 = Ms * (dmath::cos(phi_min) * u - dmath::sin(phi_min) * w);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // magnetics/near_field.cpp — the near-field pair model (near_field.hpp): the coupling table,
 // the fade, the pair list, and the model's field, energy and forces.
 #include "magnetics/near_field.hpp"
+#include "magnetics/det_math.hpp"
 
 #include "magnetics/dipole_field.hpp"
 
@@ -32,14 +33,14 @@ std::vector<double> spline_second(const std::vector<double>& y, double h) {
 }
 
 double table_step() {
-  return (std::log(kTableGapMax) - std::log(kTableGapMin)) / (kTableNodes - 1);
+  return (dmath::log(kTableGapMax) - dmath::log(kTableGapMin)) / (kTableNodes - 1);
 }
 
 // Value and derivative in x of the spline (y, m) at x = ln g_e.
 void spline_eval(const std::vector<double>& y, const std::vector<double>& m, double x,
                  double* v, double* dv) {
   const double h = table_step();
-  const double x0 = std::log(kTableGapMin);
+  const double x0 = dmath::log(kTableGapMin);
   double s = (x - x0) / h;
   int k = static_cast<int>(std::floor(s));
   k = std::clamp(k, 0, kTableNodes - 2);
@@ -61,8 +62,8 @@ std::string validate(const NearFieldOptions& o) {
 // g_e = g_m + g_s ln(1 + e^x), x = (g − g_m)/g_s (a softplus, finite for any x)
 double pair_effective_gap(double g, double* dge_dg) {
   const double x = (g - kPairContactGap) / kPairSmoothGap;
-  const double sp = x > 0 ? x + std::log1p(std::exp(-x)) : std::log1p(std::exp(x));
-  if (dge_dg) *dge_dg = x > 0 ? 1.0 / (1.0 + std::exp(-x)) : std::exp(x) / (1.0 + std::exp(x));
+  const double sp = x > 0 ? x + dmath::log1p(dmath::exp(-x)) : dmath::log1p(dmath::exp(x));
+  if (dge_dg) *dge_dg = x > 0 ? 1.0 / (1.0 + dmath::exp(-x)) : dmath::exp(x) / (1.0 + dmath::exp(x));
   return kPairContactGap + kPairSmoothGap * sp;
 }
 
@@ -71,7 +72,7 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
   int r = 0;
   while (r < kTableMuCount - 2 && mu_r > kTableMu[r + 1]) ++r;
   const double w = std::clamp(
-      (std::log(mu_r) - std::log(kTableMu[r])) / (std::log(kTableMu[r + 1]) - std::log(kTableMu[r])),
+      (dmath::log(mu_r) - dmath::log(kTableMu[r])) / (dmath::log(kTableMu[r + 1]) - dmath::log(kTableMu[r])),
       0.0, 1.0);
   par_.resize(kTableNodes);
   perp_.resize(kTableNodes);
@@ -87,7 +88,7 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
 PairCoupling PairCouplingTable::at(double g) const {
   double dge = 0;
   const double ge = pair_effective_gap(g, &dge);
-  const double x = std::log(ge), dx = dge / ge;
+  const double x = dmath::log(ge), dx = dge / ge;
   PairCoupling c;
   double d = 0;
   spline_eval(par_, par2_, x, &c.par, &d);
@@ -119,7 +120,7 @@ double pair_switch(double g, double* dS_dg) {
 PairFade pair_fade(double h) {
   PairFade f;
   if (h <= 0) return f;
-  const double z = std::pow(h / kPairFadeField, kPairFadePower);
+  const double z = dmath::pow(h / kPairFadeField, kPairFadePower);
   f.phi = 1.0 / (1.0 + z);
   f.dphi_dh = -f.phi * f.phi * kPairFadePower * z / h;
   return f;
@@ -149,7 +150,7 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   for (std::size_t j = 0; j < n; ++j) {
     if (set.kind[j] != MomentKind::Induced || !(set.volume[j] > 0)) continue;
     if (set.group[j] >= 0 && count[set.group[j]] != 1) continue;
-    const double a = std::cbrt(3.0 * set.volume[j] / (4.0 * kPi));
+    const double a = dmath::cbrt(3.0 * set.volume[j] / (4.0 * kPi));
     const double rad = j < set.radius.size() ? set.radius[j] : 0.0;
     if (rad > 0 && std::abs(rad - a) > 1e-6 * a) continue;
     ws->a[j] = a;

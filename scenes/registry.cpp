@@ -1,6 +1,7 @@
 // scenes/registry.cpp — the five scenes as data (the paper's four and crystal_balls). Sizes and strengths are ours
 // (the paper gives only counts); each is stated beside its value, in SI units.
 #include "scenes/registry.hpp"
+#include "magnetics/det_math.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -92,6 +93,14 @@ void stack_balls(SceneDesc* s, int N, int side, double r, double gap, double cx,
 constexpr double kStackGap = 0.001;
 constexpr int kBallsUpSide = 9;    // balls per row (9 × 9 per layer, the paper's 9×9×3)
 constexpr int kBallsUpLayers = 3;  // the paper's layers: the magnet's height is set from them
+
+// The rotation by `angle` (rad) about the unit `axis`: q = (cos ½θ, sin ½θ · axis), with the
+// deterministic sine and cosine (a scene's start is part of its state hash)
+Quat axis_angle(double angle, const Vec3& axis) {
+  const double h = 0.5 * angle;
+  const double s = mag::dmath::sin(h);
+  return Quat(mag::dmath::cos(h), s * axis.x(), s * axis.y(), s * axis.z());
+}
 
 // balls_up — 243 iron balls (9×9×3, radius 5 mm) resting on frictionless ground; a 3 cm
 // N52 cube magnet (29.7 A·m², 1.1e6 A/m · (3 cm)³) fixed 3 cm above the top layer pulls them
@@ -204,7 +213,7 @@ SceneDesc alphabets(const SceneParams& p) {
   for (int k = 0; k < N; ++k) {
     const int i = k % 5, j = (k / 5) % 5, l = (k / 25) % 4, extra = k / 100;
     const Vec3 pos((i - 2) * pitch, (j - 2) * pitch, (l - 1.5) * pitch + extra * repeat_shift);
-    const Quat q = Quat(Eigen::AngleAxisd(kPi * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
+    const Quat q = axis_angle(kPi * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized());
     s.bodies.push_back(letter(k, pos, q));
   }
   const double Rc = 0.02;  // (m) radius of the invisible collider around the central moment
@@ -317,11 +326,11 @@ SceneDesc sakura_tree(const SceneParams& p) {
   capsule(base, fork, trunk_r);
   for (int i = 0; i < 4; ++i) {
     const double a = kPi / 2 * i + branch_turn;
-    const Vec3 mid = fork + Vec3(branch_out * std::cos(a), branch_out * std::sin(a), branch_up);
+    const Vec3 mid = fork + Vec3(branch_out * mag::dmath::cos(a), branch_out * mag::dmath::sin(a), branch_up);
     capsule(fork, mid, branch_r);
     for (int k = -1; k <= 1; k += 2) {
       const double b = a + twig_spread * k;
-      const Vec3 tip = mid + Vec3(twig_out * std::cos(b), twig_out * std::sin(b), twig_up);
+      const Vec3 tip = mid + Vec3(twig_out * mag::dmath::cos(b), twig_out * mag::dmath::sin(b), twig_up);
       capsule(mid, tip, twig_r);
       // the branch end: an N52 sphere magnet of radius Rt magnetized along the branch, a
       // static body of its own (coloured as a magnet); its collider keeps iron at ≥ Rt + r
@@ -390,7 +399,7 @@ SceneDesc crystal_balls(const SceneParams& p) {
   for (int k = 0; k < N; ++k) {
     const double z = 1.0 - 2.0 * (k + 0.5) / N;
     const double rho = std::sqrt(1.0 - z * z);
-    const Vec3 pos(R * rho * std::cos(golden * k), R * rho * std::sin(golden * k), R * z);
+    const Vec3 pos(R * rho * mag::dmath::cos(golden * k), R * rho * mag::dmath::sin(golden * k), R * z);
     BodyDesc b = iron_ball("ball_" + std::to_string(k), pos + centre, r);
     b.type = BodyType::Static;
     s.bodies.push_back(b);
