@@ -81,7 +81,7 @@ HeapRun run_heap(const std::string& scene, int count, double strength, double se
 }  // namespace
 
 TEST_CASE("a reduced falling_magnet heap settles under the default force and keeps being pumped under eq. 4",
-          "[stability][energy]") {
+          "[stability][energy][long]") {
   // 300 balls (2 layers and a bit), the magnet lands at ≈ 0.2 s; 2 s, window the last 0.5 s
   const auto classic = run_heap("falling_magnet", 300, 1.0, 2.0, 0.5, {});
   INFO("default: heap " << classic.heap_speed << " m/s, E rose above its running minimum by "
@@ -128,7 +128,7 @@ TEST_CASE("the near-field pair model keeps the energy audit closed", "[stability
 }
 
 TEST_CASE("sakura_tree at 3x on the robustness matrix's corner: the scene's load sub-steps keep it whole",
-          "[stability][energy][sakura_tree]") {
+          "[stability][energy][sakura_tree][long]") {
   // 500 balls, 3x, QuickStep W 1.0 with 20 iterations, Δt_r 2 ms, 0.8 s: balls held at a tip
   // are pressed into their contacts at ~5·10^4 m/s^2. With one step per frame a ball reaches
   // 1000 m/s at step 79; with the scene's sub-steps (by motion and load) the run ends whole.

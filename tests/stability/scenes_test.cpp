@@ -54,7 +54,7 @@ TEST_CASE("balls_up at 3x strength with 20 QuickStep iterations keeps its pile: 
 }
 
 TEST_CASE("falling_magnet without magnetism comes to rest: rolling resistance on the ground",
-          "[stability][falling_magnet]") {
+          "[stability][falling_magnet][long]") {
   // The mechanical control: the 12×12×8 block collapses under the falling magnet (strength
   // 0.001: no magnetic force to speak of). Without rolling resistance the balls roll on for
   // ever (final KE 0.126 J, 17 beyond 1 m at 2 s).
@@ -68,7 +68,7 @@ TEST_CASE("falling_magnet without magnetism comes to rest: rolling resistance on
 }
 
 TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is thrown far",
-          "[stability][falling_magnet]") {
+          "[stability][falling_magnet][long]") {
   // 1032 balls, 1.2 s, the scene's defaults; window the last 0.2 s
   const auto r = run_scene("falling_magnet", Method::Anderson, 1.2, 0.2);
   INFO("held " << r.last.held << ", attached " << r.last.attached << ", escaped "
@@ -81,7 +81,7 @@ TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is
 }
 
 TEST_CASE("falling_magnet at 3x strength with 40 QuickStep iterations: the default throws nothing, eq. 4 runs away",
-          "[stability][falling_magnet]") {
+          "[stability][falling_magnet][long]") {
   // 600 balls, 0.6 s. eq. 4's surplus work, with its reaction-symmetric forces' net torque,
   // spun and rolled the magnet and its heap across the floor at this corner.
   auto run = [](Method m) {

@@ -40,7 +40,7 @@ const StressBound kBounds[] = {
 }  // namespace
 
 TEST_CASE("stress sweep: every method stays finite and under its measured speed and escape bounds, 1-10x, dt_m 30-200 ns",
-          "[stability][stress]") {
+          "[stability][stress][long]") {
   // balls_up cut to 54 balls (6 × 9, one layer), 0.3 s. An "exploding body" in the table is
   // one faster than 100 m/s.
   int exploded = 0;

@@ -1,23 +1,26 @@
 #!/usr/bin/env bash
 # tools/scripts/test.sh — builds the test suite and runs it with CTest.
 #
-#   bash tools/scripts/test.sh            Release build in build/release, every test
+#   bash tools/scripts/test.sh            Release build in build/release, the default suite:
+#                                         every test but those labelled long (≤ 8 min, 2 cores)
+#   bash tools/scripts/test.sh --all      every test, the long end-to-end runs too (~40 min)
 #   bash tools/scripts/test.sh --asan     ASan+UBSan build in build/asan (renderer off), portable
 #   bash tools/scripts/test.sh --portable Release build in build/portable, portable
 #   bash tools/scripts/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability)
-# Portable: -DMAGSIM_NATIVE=OFF, baseline x86-64 and the portable field kernels, whose golden
-# state hashes hold on every x86-64 CPU (tests/engine/golden_hash_test.cpp); the Release
-# build checks the AVX-512 ones where the CPU has AVX-512.
+# Portable: -DMAGSIM_NATIVE=OFF, baseline x86-64 and the portable field kernels. Every build
+# gives the same golden state hashes on every x86-64 CPU (tests/engine/golden_hashes.txt).
 # Installs the Debian packages first if any is missing (tools/scripts/setup.sh --deps-only).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 preset=release
 ctest_args=()
+select=(-LE long)
 while [ $# -gt 0 ]; do
   case "$1" in
     --asan) preset=asan ;;
     --portable) preset=portable ;;
+    --all) select=() ;;
     --) shift; ctest_args=("$@"); break ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "test.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
@@ -37,4 +40,4 @@ else
   cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
 cmake --build "build/$preset" -j"$(nproc)"
-ctest --test-dir "build/$preset" --output-on-failure -j"$(nproc)" "${ctest_args[@]}"
+ctest --test-dir "build/$preset" --output-on-failure -j"$(nproc)" "${select[@]}" "${ctest_args[@]}"
