@@ -1,0 +1,80 @@
+#!/usr/bin/python3
+"""tools/reference/near_field_fem_validate.py — the checks of the finite-element reference
+(axisym_fem.py), printed as markdown tables:
+
+  1. linear law M = chi0 H (mu_r = 1000) against the exact two-sphere solution (two_spheres.py)
+     at every gap of the table, mesh levels 1, 2, 4: force and moment;
+  2. the tanh curve at g = 0.003a against the finite-element row the pair model was fitted
+     to (near_field_chart.py's FEM_F), levels 1 and 2;
+  3. the outer radius: R = 25 and 50 chain half lengths;
+  4. the force as the co-energy derivative against the Maxwell stress.
+
+    /usr/bin/python3 tools/reference/near_field_fem_validate.py [--skip-row]"""
+import argparse
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import axisym_fem as af  # noqa: E402
+import near_field_chart as nfc  # noqa: E402
+import two_spheres as ts  # noqa: E402
+
+GAPS = (1.0, 0.3, 0.1, 0.03, 0.01, 0.003)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--skip-row", action="store_true")
+    args = ap.parse_args(argv)
+    t0 = time.time()
+    lin = af.Material(1000.0, linear=True)
+    print("1. Linear (M = 999 H), force on the upper ball and moment of the pair, FEM / exact - 1:\n")
+    print("| g/a | exact F (mu0 H0^2 a^2) | level 1 | level 2 | level 4 | exact moment (H0 a^3) | level 1 | level 2 | level 4 |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for g in GAPS:
+        fx, _ = ts.converged_force(1000.0, g, "axial", rtol=1e-9)
+        mx = 2.0 * ts.converge(1000.0, g, "axial", rtol=1e-9)[1].moment
+        ef, em = [], []
+        for lev in (1.0, 2.0, 4.0):
+            ch = af.Chain(2, g)
+            mesh = af.Mesh(ch, af.default_R(ch), lev)
+            s = af.solve(mesh, 1.0, lin)
+            ef.append(af.force(mesh, s, 0) / fx - 1)
+            em.append(af.moment(mesh, s) / mx - 1)
+        print(f"| {g:g} | {fx:.6g} | " + " | ".join(f"{e:+.2e}" for e in ef) + f" | {mx:.6g} | "
+              + " | ".join(f"{e:+.2e}" for e in em) + " |", flush=True)
+    if not args.skip_row:
+        print("\n2. tanh curve, g = 0.003a: F (mu0 Ms^2 a^2) against the given FEM row:\n")
+        print("| H0/Ms | given | level 1 | level 2 | level 2 / given |")
+        print("|---|---|---|---|---|")
+        res = {}
+        for lev in (1.0, 2.0):
+            mesh, rows = af.run_case(2, 0.003, nfc.FEM_H, refine=lev)
+            res[lev] = [r["forces"][0] for r in rows]
+        for k, h in enumerate(nfc.FEM_H):
+            print(f"| {h:.4g} | {nfc.FEM_F[k]:.4g} | {res[1.0][k]:.5g} | {res[2.0][k]:.5g} | "
+                  f"{res[2.0][k] / nfc.FEM_F[k]:.3f} |", flush=True)
+    print("\n3. Outer radius (linear, g = 0.1a, level 2): F / exact - 1\n")
+    fx, _ = ts.converged_force(1000.0, 0.1, "axial", rtol=1e-9)
+    for mult in (12.5, 25.0, 50.0):
+        ch = af.Chain(2, 0.1)
+        mesh = af.Mesh(ch, mult * ch.top, 2.0)
+        s = af.solve(mesh, 1.0, lin)
+        print(f"- R = {mult:g} x {ch.top:g} a: {af.force(mesh, s, 0) / fx - 1:+.2e} ({mesh.nodes} nodes)", flush=True)
+    print("\n4. Co-energy derivative (nodes moved by +-0.01 g psi) against the Maxwell stress, level 2:\n")
+    for n, g, h in ((2, 0.003, 0.01), (2, 0.1, 0.1), (5, 0.003, 0.03)):
+        ch = af.Chain(n, g)
+        mesh = af.Mesh(ch, af.default_R(ch), 2.0)
+        s = af.solve(mesh, h)
+        k = len(ch.centres) - 1
+        fm = af.force(mesh, s, k)
+        fc = af.coenergy_force(mesh, h, k, 0.01 * g, phi0=s.phi)
+        print(f"- N = {n}, g = {g:g}a, H0 = {h:g} Ms, ball at z = {ch.centres[k]:.4g}a: Maxwell {fm:.8g}, "
+              f"co-energy {fc:.8g}, relative {fc / fm - 1:+.2e}", flush=True)
+    print(f"\n({time.time() - t0:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
