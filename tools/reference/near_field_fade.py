@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """tools/reference/near_field_fade.py — a Python prototype of the engine's near-field pair
-model on axial chains (balls on the field axis, H0 along it), with its saturation fade
+model on axial chains (balls on the field axis, H0 along it), with its saturation treatment
 replaceable, fitted to the finite-element table (near_field_fem.csv) on a training half and
 checked on the other half.
 
@@ -8,23 +8,26 @@ checked on the other half.
 
 The model (magnetics/PHYSICS.md, "The near field"), restricted to the axis: every moment is
 along z, ball i feels
-    H_i = H0 + sum_j K(d_ij) m_j,   K(d) = 2/(4 pi d^3) + c(g, h) Dt(g)/a^3,   c = S(g) phi(h, g),
-with Dt(g) the exact axial coupling correction at mu_r = 1000 (magnetics/near_field_table.inc,
-a natural cubic spline in ln g_e), g_e the softplus contact gap, S the cut-off step and h =
-H0/Ms; m_i = V Ms tanh(3 H_i/Ms) (the engine's curve). The pair energy is
+    H_i = H0 + sum_j K(d_ij) m_j,   K(d) = 2/(4 pi d^3) + C(g, h)/a^3,
+with C the coupling correction: the engine's is C = S(g) phi(h) Dt(g), Dt the exact axial
+correction at mu_r = 1000 (magnetics/near_field_table.inc, a natural cubic spline in ln g_e),
+g_e the softplus contact gap, S the cut-off step, phi = 1/(1 + (h/0.0138)^1.2), h = H0/Ms;
+m_i = V Ms tanh(3 H_i/Ms) (the engine's curve). The pair energy is
 E = -mu0 sum_{i<j} m_i m_j K(d_ij), so by the envelope theorem the force on ball i is
     F_i = mu0 sum_j m_i m_j K'(d_ij) sign(z_i - z_j)
-(-grad U*, the classic force), K' including the fade's gap derivative. The engine's fade is
-phi = 1/(1 + (h/h0)^p), h0 = 0.0138, p = 1.2 at every gap.
+(-grad U*, the classic force), K' including dC/dg. With the engine's C it reproduces magsolve
+--near-field pair to 4e-6.
 
-The candidate fade: the contact saturates when the gap's flux density reaches Ms. In the
-linear regime the field in the gap at the axis is E(g) H0, with E the gap's enhancement;
-the exact linear pair (mu_r = 1000) gives it as the potential drop across the gap over its
-width. So the fade is a function of h/h_s(g), h_s = 1/E(g), the applied field at which the
-contact saturates:
-    phi = 1/(1 + (h/(k h_s(g)))^p),
-k and p fitted. The script fits both forms' parameters on the training half (checkerboard
-over gap x field) minimizing the largest |ln(model/FEM)|, and prints the check half."""
+Candidates (the contact saturates where the gap's flux density reaches Ms):
+  A. the engine's fade with its scale at the contact's saturation field, phi =
+     1/(1 + (h/(k h_s(g)))^p), h_s = 1/E(g) the applied field at which the linear gap field at
+     the axis reaches Ms (E from axisym_fem.py's linear solution). Its dphi/dg term repels.
+  B. the saturated contact as a wider gap: C = S(g) Dt(G), G = g_e(g) + kappa h^q. The iron
+     cannot carry much more than mu0 Ms, so the part of the contact whose linear field would
+     exceed Ms acts as air: a gap widened by a length that grows with the applied field.
+     dG/dg > 0 and Dt falls with the gap, so C always attracts; kappa, q are fitted.
+The fits use a checkerboard over gap x field (training: gap index + field index even),
+least squares of ln(model/FEM)."""
 import argparse
 import csv
 import math
@@ -120,7 +123,7 @@ def K_and_dK(d, h, correction):
     return K + c / A ** 3, dK + dc / A ** 4
 
 
-def chain_model(n, gap, h0, fade):
+def chain_model(n, gap, h0, correction):
     """(z forces on every ball, N; chain moment, A m^2) of n balls at gap `gap` (radii)."""
     z = (np.arange(n) - 0.5 * (n - 1)) * (2.0 + gap) * A
     Kmat = np.zeros((n, n))
@@ -128,7 +131,7 @@ def chain_model(n, gap, h0, fade):
     for i in range(n):
         for j in range(n):
             if i != j:
-                Kmat[i, j], dKmat[i, j] = K_and_dK(abs(z[i] - z[j]), h0, fade)
+                Kmat[i, j], dKmat[i, j] = K_and_dK(abs(z[i] - z[j]), h0, correction)
     H0 = h0 * MS
 
     def res(M):
@@ -153,11 +156,11 @@ def load_fem(path):
     return cells
 
 
-def ratio_table(cells, fade, keys):
+def ratio_table(cells, correction, keys):
     out = {}
     for key in keys:
         n, g, h = key
-        F, mom = chain_model(n, g, h, fade)
+        F, mom = chain_model(n, g, h, correction)
         c = cells[key]
         top = max(c["F"])
         out[key] = {"end": F[top] / c["F"][top], "moment": mom / c["moment"],
