@@ -62,7 +62,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.spatial import Delaunay
+from scipy.spatial import Delaunay, cKDTree
 
 MU_R = 1000.0
 
@@ -160,7 +160,6 @@ def boundary_points(chain, size):
     oth = outer / R
     out = np.column_stack((R * np.sin(oth), R * np.cos(oth)))
     bnd = np.vstack((np.column_stack((pl, 0 * pl)), np.column_stack((0 * ax, ax)), out))
-    # drop boundary points (axis, plane) that fall on or next to a sphere arc point
     return arcs, bnd
 
 
@@ -199,14 +198,10 @@ class Mesh:
         keep = (fill[:, 0] > 0.55 * hf) & (fill[:, 1] > 0.55 * hf) & (r < R - 0.55 * hf)
         keep &= chain.dist_spheres(fill[:, 0], fill[:, 1]) > 0.55 * hf
         fill = fill[keep]
-        # boundary points of the axis / plane that coincide with arc points are merged
-        ha = size(arcs[:, 0], arcs[:, 1])
+        # axis / plane points next to an arc point (the poles, a cut sphere's rim) give way to it
         hb = size(bnd[:, 0], bnd[:, 1])
-        from scipy.spatial import cKDTree
-        tree = cKDTree(arcs)
-        dist, _ = tree.query(bnd)
+        dist, _ = cKDTree(arcs).query(bnd)
         bnd = bnd[dist > 0.45 * hb]
-        # arc points of a sphere cut by z = 0 (and its pole on the axis) are kept as they are
         p = np.vstack((arcs, bnd, fill))
         # merge exact duplicates
         key = np.round(p / 1e-12).astype(np.int64)
@@ -226,7 +221,6 @@ class Mesh:
         self.dirichlet = (p[:, 1] < 1e-12) | (r > R * (1 - 1e-9))
         self.size = size
         self.geometry()
-        del ha
 
     @staticmethod
     def _area(p, t):
@@ -311,10 +305,10 @@ def solve(mesh, H0, material=None, phi0=None, tol=1e-18, max_iter=200, verbose=F
     if phi0 is None:
         phi[free] = -H0 * p[free, 1]
     t = mesh.t
-    # CSR assembly pattern (summed once; data re-summed per iteration with bincount)
-    K0 = sp.coo_matrix((np.arange(len(mesh.rows), dtype=float) + 1, (mesh.rows, mesh.cols)), shape=(n, n)).tocsr()
+    # the CSR pattern, built once; each iteration sums the element entries into its slots
+    K0 = sp.coo_matrix((np.ones(len(mesh.rows)), (mesh.rows, mesh.cols)), shape=(n, n)).tocsr()
     K0.sum_duplicates()
-    # map each COO entry to its CSR slot
+    K0.sort_indices()
     lin = mesh.rows.astype(np.int64) * n + mesh.cols
     csr_lin = np.repeat(np.arange(n), np.diff(K0.indptr)).astype(np.int64) * n + K0.indices
     slot = np.searchsorted(csr_lin, lin)
