@@ -7,13 +7,18 @@
   2. the tanh curve at g = 0.003a against the finite-element row the pair model was fitted
      to (near_field_chart.py's FEM_F), levels 1 and 2;
   3. the outer radius: R = 25 and 50 chain half lengths;
-  4. the force as the co-energy derivative against the Maxwell stress.
+  4. the force as the co-energy derivative against the Maxwell stress;
+  5. (--laws) the given row against two other knees of the same chi0 = 999, level 1: whether
+     the curve's shape explains the difference.
 
-    /usr/bin/python3 tools/reference/near_field_fem_validate.py [--skip-row]"""
+    /usr/bin/python3 tools/reference/near_field_fem_validate.py [--skip-row] [--laws]"""
 import argparse
+import math
 import os
 import sys
 import time
+
+import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import axisym_fem as af  # noqa: E402
@@ -23,9 +28,57 @@ import two_spheres as ts  # noqa: E402
 GAPS = (1.0, 0.3, 0.1, 0.03, 0.01, 0.003)
 
 
+class Langevin(af.Material):
+    """M = Ms L(3 chi0 H/Ms), L(x) = coth x - 1/x (initial slope chi0); co-energy beyond H^2/2:
+    (Ms^2/(3 chi0)) ln(sinh x / x)."""
+
+    def __init__(self, chi0=999.0):
+        self.chi0, self.linear, self.c = chi0, False, 3.0 * chi0
+
+    def _x(self, H):
+        return np.maximum(self.c * H, 1e-8)
+
+    def M(self, H):
+        x = self._x(H)
+        return np.where(x < 1e-3, x / 3, 1 / np.tanh(x) - 1 / x)
+
+    def M_over_H(self, H):
+        x = self._x(H)
+        return np.where(x < 1e-3, self.c / 3 * (1 - x * x / 15), (1 / np.tanh(x) - 1 / x) / np.maximum(H, 1e-300))
+
+    def dM(self, H):
+        x = self._x(H)
+        return np.where(x < 1e-3, self.c / 3 * (1 - x * x / 5), self.c * (1 / x ** 2 - 1 / np.sinh(np.minimum(x, 300.0)) ** 2))
+
+    def w(self, H):
+        x = self._x(H)
+        return np.where(x < 1e-3, x * x / 6, x + np.log1p(-np.exp(-2 * x)) - math.log(2) - np.log(x)) / self.c
+
+
+class FrohlichKennelly(af.Material):
+    """M = chi0 H/(1 + chi0 H/Ms); co-energy beyond H^2/2: (Ms^2/chi0)(x - ln(1 + x)), x = chi0 H/Ms."""
+
+    def __init__(self, chi0=999.0):
+        self.chi0, self.linear = chi0, False
+
+    def M(self, H):
+        return self.chi0 * H / (1 + self.chi0 * H)
+
+    def M_over_H(self, H):
+        return self.chi0 / (1 + self.chi0 * H)
+
+    def dM(self, H):
+        return self.chi0 / (1 + self.chi0 * H) ** 2
+
+    def w(self, H):
+        x = self.chi0 * H
+        return (x - np.log1p(x)) / self.chi0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--skip-row", action="store_true")
+    ap.add_argument("--laws", action="store_true", help="also section 5 (about 1 min)")
     args = ap.parse_args(argv)
     t0 = time.time()
     lin = af.Material(1000.0, linear=True)
@@ -72,6 +125,19 @@ def main(argv=None):
         fc = af.coenergy_force(mesh, h, k, 0.01 * g, phi0=s.phi)
         print(f"- N = {n}, g = {g:g}a, H0 = {h:g} Ms, ball at z = {ch.centres[k]:.4g}a: Maxwell {fm:.8g}, "
               f"co-energy {fc:.8g}, relative {fc / fm - 1:+.2e}", flush=True)
+    if args.laws:
+        print("\n5. g = 0.003a, level 1: F / the given row for three knees of chi0 = 999:\n")
+        print("| law | " + " | ".join(f"{h:.3g}" for h in nfc.FEM_H) + " |")
+        print("|---" * (len(nfc.FEM_H) + 1) + "|")
+        ch = af.Chain(2, 0.003)
+        mesh = af.Mesh(ch, af.default_R(ch), 1.0)
+        for name, mat in (("tanh", af.Material()), ("Langevin", Langevin()), ("Frohlich-Kennelly", FrohlichKennelly())):
+            prev, out = None, []
+            for h, fg in zip(nfc.FEM_H, nfc.FEM_F):
+                s = af.solve(mesh, h, mat, phi0=None if prev is None else prev.phi * h / prev.H0)
+                prev = s
+                out.append(f"{af.force(mesh, s, 0) / fg:.3f}")
+            print(f"| {name} | " + " | ".join(out) + " |", flush=True)
     print(f"\n({time.time() - t0:.0f} s)")
     return 0
 
