@@ -9,9 +9,11 @@
   3. the outer radius: R = 25 and 50 chain half lengths;
   4. the force as the co-energy derivative against the Maxwell stress;
   5. (--laws) the given row against two other knees of the same chi0 = 999, level 1: whether
-     the curve's shape explains the difference.
+     the curve's shape explains the difference;
+  6. (--families) four cells of the table on two other mesh families at level 2 (the contact
+     grading halved; the surface and far-field sizes halved) against the table's level 4.
 
-    /usr/bin/python3 tools/reference/near_field_fem_validate.py [--skip-row] [--laws]"""
+    /usr/bin/python3 tools/reference/near_field_fem_validate.py [--skip-row] [--laws] [--families]"""
 import argparse
 import math
 import os
@@ -79,6 +81,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--skip-row", action="store_true")
     ap.add_argument("--laws", action="store_true", help="also section 5 (about 1 min)")
+    ap.add_argument("--families", action="store_true", help="also section 6 (about 4 min alone)")
     args = ap.parse_args(argv)
     t0 = time.time()
     lin = af.Material(1000.0, linear=True)
@@ -138,6 +141,25 @@ def main(argv=None):
                 prev = s
                 out.append(f"{af.force(mesh, s, 0) / fg:.3f}")
             print(f"| {name} | " + " | ".join(out) + " |", flush=True)
+    if args.families:
+        import csv
+        path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "near_field_fem.csv")
+        rows = list(csv.DictReader(open(path)))
+        print("\n6. Other mesh families at level 2 against the table (level 4): F / table - 1\n")
+        print("| N | g/a | H0/Ms | contact grading k = 0.06 | surface a/28, far growth 0.125 |")
+        print("|---|---|---|---|---|")
+        for n, g, h in ((2, 0.01, 0.03), (2, 0.003, 0.01), (2, 0.03, 0.1), (3, 0.003, 0.03)):
+            ref = next(float(r["Fz_mu0Ms2a2"]) for r in rows if int(r["N"]) == n and float(r["gap_over_a"]) == g
+                       and float(r["H0_over_Ms"]) == h and int(r["ball"]) == n - 1)
+            ch = af.Chain(n, g)
+            out = []
+            for kw in ({"k": 0.06}, {"h_surf": 0.035, "q": 0.125}):
+                mesh = af.Mesh(ch, af.default_R(ch), 2.0, **kw)
+                prev = None
+                for hh in (h / 10, h / 3, h):  # the table's continuation, shortened
+                    prev = af.solve(mesh, hh, phi0=None if prev is None else prev.phi * hh / prev.H0)
+                out.append(f"{af.force(mesh, prev, len(ch.centres) - 1) / ref - 1:+.1e} ({mesh.nodes} nodes)")
+            print(f"| {n} | {g:g} | {h:g} | " + " | ".join(out) + " |", flush=True)
     print(f"\n({time.time() - t0:.0f} s)")
     return 0
 
