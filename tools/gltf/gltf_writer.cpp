@@ -90,7 +90,9 @@ double metalness(const std::array<float, 3>& c) {
   return 1.0 - x * x * (3 - 2 * x);
 }
 
-// A camera's node rotation: glTF cameras look along their local −z with +y up.
+// A camera's node rotation in glTF's axes: glTF cameras look along their local −z with +y up,
+// so the columns are the world's right, up and backward directions (converted as vectors; the
+// camera's own frame is glTF's by definition and is not converted).
 Quat camera_rotation(const Camera& c) {
   const Vec3 f = (c.target - c.eye).normalized();
   Vec3 r = f.cross(c.up);
@@ -98,9 +100,9 @@ Quat camera_rotation(const Camera& c) {
   r.normalize();
   const Vec3 u = r.cross(f);
   Eigen::Matrix3d m;
-  m.col(0) = r;
-  m.col(1) = u;
-  m.col(2) = -f;
+  m.col(0) = to_gltf(r);
+  m.col(1) = to_gltf(u);
+  m.col(2) = to_gltf(Vec3(-f));
   return Quat(m).normalized();
 }
 
@@ -233,8 +235,10 @@ GlbParts build_glb(const SceneInfo& scene, const Recording& rec) {
                      {"perspective", {{"yfov", c.fov_y_deg * 3.14159265358979323846 / 180}, {"aspectRatio", c.aspect},
                                       {"znear", znear}, {"zfar", zfar}}}}};
     roots.push_back(nodes.size());
+    // extras: the scene's camera in magsim's axes, to check the node against
     nodes.push_back({{"name", "camera"}, {"camera", 0}, {"translation", vec(to_gltf(c.eye))},
-                     {"rotation", quat_xyzw(to_gltf(camera_rotation(c)))}});
+                     {"rotation", quat_xyzw(camera_rotation(c))},
+                     {"extras", {{"magsim_camera", {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}}}}}});
   }
 
   // the animation: one key accessor, a translation and a rotation per moving body, a scale

@@ -13,6 +13,7 @@ checks:
 - one mesh datablock per distinct shape (kind, size, material), shared by all its objects;
 - one object per glTF node: bodies (as many as states.csv has), shapes, channel nodes, the
   ground and the camera;
+- the camera at the scene's eye, looking at its target (the camera node's extras);
 - with --channels: each body's "<body>.channels" object has Blender scale axis k = channel k,
   equal to the file's values at the checked frames, and, as a check independent of the file,
   m_norm of a body with only permanent moments equals |extras.moment| and speed and spin of a
@@ -28,6 +29,7 @@ import sys
 import time
 
 import bpy
+from mathutils import Vector
 
 POS_TOL = 1e-5  # m
 ROT_TOL = 1e-5  # rad
@@ -92,6 +94,12 @@ def rotation_angle(q1, q2):
     return 2 * math.atan2(math.sqrt(x * x + y * y + z * z), abs(w))
 
 
+def angle_between(a, b):
+    """The angle (rad) between two vectors, in doubles: atan2 keeps small angles exact."""
+    cross = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+    return math.atan2(math.sqrt(sum(x * x for x in cross)), sum(x * y for x, y in zip(a, b)))
+
+
 class Checks:
     def __init__(self):
         self.failed = 0
@@ -142,6 +150,20 @@ def main():
     c.check(shared and len(blocks) == distinct and len(bpy.data.meshes) == distinct + ground,
             "meshes: %d datablocks for %d distinct shapes (+%d ground) of %d shape objects" %
             (len(bpy.data.meshes), distinct, ground, len(shape_key)))
+
+    # the camera: at the scene's eye, looking at its target, its up on the scene's up side
+    cams = [o for o in bpy.data.objects if o.type == "CAMERA" and "magsim_camera" in o.keys()]
+    if cams:
+        want = cams[0]["magsim_camera"]
+        m = cams[0].matrix_world
+        eye, target, up = (Vector(want[k]) for k in ("eye", "target", "up"))
+        fwd = m.to_3x3() @ Vector((0, 0, -1))
+        cam_up = m.to_3x3() @ Vector((0, 1, 0))
+        aim = angle_between(tuple(fwd), tuple(target - eye))
+        c.check((m.to_translation() - eye).length <= POS_TOL and aim <= 1e-5 and cam_up.dot(up) > 0,
+                "camera: at the scene's eye, %.1e rad off the line to its target" % aim)
+    else:
+        c.check(False, "camera: none in the file")
 
     # poses at the first, second, middle and last frame
     picks = sorted({0, min(1, len(frames) - 1), len(frames) // 2, len(frames) - 1})

@@ -41,8 +41,8 @@ Counts counts(const engine::SceneDesc& s) {
   return c;
 }
 
-// the ground reaches as far as the renderer's (render/camera.cpp): 12 scene radii, or 3 times
-// the camera's distance from the scene
+// the ground reaches 12 scene radii, as the renderer's (render/camera.cpp), or 20 times the
+// camera's distance from the scene: the renderer fades its edge out, a plain quad cannot
 double ground_half_size(const engine::Model& m) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
   for (int b = 0; b < m.nbody; ++b) {
@@ -54,7 +54,7 @@ double ground_half_size(const engine::Model& m) {
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
   const double radius = std::max(0.5 * (hi - lo).norm(), 1e-3);
   const double dist = (m.camera.eye.cast<double>() - centre).norm();
-  return std::max(12 * radius, 3 * dist);
+  return std::max(12 * radius, 20 * dist);
 }
 
 }  // namespace
