@@ -3,10 +3,12 @@
 // states.csv, translations equal to states.csv's, and the exit codes of a bad path, a failed
 // run and a file above glTF's 4 GiB.
 #include "tests/tools/cli/run_command.hpp"
+#include "tools/gltf/gltf_meshes.hpp"
 
 #include <catch2/catch.hpp>
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -188,4 +190,37 @@ TEST_CASE("magsim-scene --gltf: a file above glTF's 4 GiB is refused before the 
   CHECK(r.out.find("4 GiB") != std::string::npos);
   CHECK(r.out.find("100002 frames") != std::string::npos);
   CHECK(!fs::exists(glb));
+}
+
+TEST_CASE("glTF meshes: triangles face outwards, normals are unit and the axes are y-up", "[tools][gltf]") {
+  using magsim::gltf::ShapeKind;
+  using magsim::gltf::Vec3;
+  const struct {
+    ShapeKind kind;
+    Vec3 size;
+  } shapes[] = {{ShapeKind::Sphere, Vec3(0.005, 0, 0)}, {ShapeKind::Box, Vec3(0.01, 0.02, 0.03)},
+                {ShapeKind::Capsule, Vec3(0.01, 0.04, 0)}, {ShapeKind::Cylinder, Vec3(0.02, 0.01, 0)}};
+  for (const auto& sh : shapes) {
+    const magsim::gltf::MeshData m = magsim::gltf::shape_mesh(sh.kind, sh.size);
+    INFO(magsim::gltf::shape_kind_name(sh.kind));
+    REQUIRE(m.indices.size() % 3 == 0);
+    auto at = [&](const std::vector<float>& v, std::uint32_t i) { return Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]); };
+    int inward = 0;
+    for (std::size_t t = 0; t < m.indices.size(); t += 3) {
+      const Vec3 a = at(m.positions, m.indices[t]), b = at(m.positions, m.indices[t + 1]), c = at(m.positions, m.indices[t + 2]);
+      const Vec3 n = (b - a).cross(c - a);
+      const Vec3 mean_normal = at(m.normals, m.indices[t]) + at(m.normals, m.indices[t + 1]) + at(m.normals, m.indices[t + 2]);
+      if (n.norm() > 0 && n.dot(mean_normal) <= 0) ++inward;
+    }
+    CHECK(inward == 0);
+    for (std::size_t i = 0; i < m.vertices(); ++i) CHECK(std::abs(at(m.normals, static_cast<std::uint32_t>(i)).norm() - 1) < 1e-6);
+  }
+  // a capsule along magsim's z lies along glTF's −y: its extent in y is 2 (r + half length)
+  const magsim::gltf::MeshData cap = magsim::gltf::shape_mesh(ShapeKind::Capsule, Vec3(0.01, 0.04, 0));
+  float lo = 0, hi = 0;
+  for (std::size_t i = 0; i < cap.vertices(); ++i) {
+    lo = std::min(lo, cap.positions[3 * i + 1]);
+    hi = std::max(hi, cap.positions[3 * i + 1]);
+  }
+  CHECK(hi - lo == Approx(0.1).epsilon(1e-6));
 }
