@@ -106,6 +106,18 @@ Quat camera_rotation(const Camera& c) {
   return Quat(m).normalized();
 }
 
+// the size components that shape a kind (a sphere's radius; a capsule's or cylinder's radius
+// and half length), the others 0: shapes that differ only in unused components share a mesh
+Vec3 used_size(ShapeKind kind, const Vec3& size) {
+  switch (kind) {
+    case ShapeKind::Sphere: return Vec3(size.x(), 0, 0);
+    case ShapeKind::Capsule:
+    case ShapeKind::Cylinder: return Vec3(size.x(), size.y(), 0);
+    case ShapeKind::Box: break;
+  }
+  return size;
+}
+
 // strictly increasing float keys: a time that rounds onto the previous one is moved up by
 // one float step (only when frames are closer than float precision)
 std::vector<float> key_times(const std::vector<double>& t) {
@@ -194,17 +206,18 @@ GlbParts build_glb(const SceneInfo& scene, const Recording& rec) {
     if (body.visible)
       for (std::size_t k = 0; k < body.shapes.size(); ++k) {
         const Shape& s = body.shapes[k];
-        const MeshKey key{static_cast<int>(s.kind), s.size.x(), s.size.y(), s.size.z(), body.color};
+        const Vec3 size = used_size(s.kind, s.size);
+        const MeshKey key{static_cast<int>(s.kind), size.x(), size.y(), size.z(), body.color};
         auto it = mesh_of.find(key);
         if (it == mesh_of.end()) {
           char name[160];
-          std::snprintf(name, sizeof name, "%s %g %g %g", shape_kind_name(s.kind), s.size.x(), s.size.y(), s.size.z());
-          it = mesh_of.emplace(key, add_mesh(shape_mesh(s.kind, s.size), name,
+          std::snprintf(name, sizeof name, "%s %g %g %g", shape_kind_name(s.kind), size.x(), size.y(), size.z());
+          it = mesh_of.emplace(key, add_mesh(shape_mesh(s.kind, size), name,
                                              material(body.color, "", metalness(body.color),
                                                       0.5 - 0.2 * metalness(body.color)))).first;
         }
         json sn{{"name", body.name + "." + shape_kind_name(s.kind) + std::to_string(k)}, {"mesh", it->second},
-                {"extras", {{"shape", shape_kind_name(s.kind)}, {"size", vec(s.size)}}}};
+                {"extras", {{"shape", shape_kind_name(s.kind)}, {"size", vec(size)}}}};
         if (!s.offset.isZero()) sn["translation"] = vec(to_gltf(s.offset));
         if (!s.rotation.coeffs().isApprox(Quat::Identity().coeffs(), 0.0)) sn["rotation"] = quat_xyzw(to_gltf(s.rotation));
         children.push_back(nodes.size());

@@ -10,7 +10,7 @@
 //   "type", "mass", "moment" (A·m², body frame, magsim axes; bodies with permanent moments),
 //   "induced_moments" (where there are any)};
 //   under it a node per shape at its offset, whose mesh is shared by every shape of the same
-//   kind, size and colour;
+//   kind, size (the components the kind uses) and colour;
 // - materials from the renderer's colours (near-grey = metal, as render/shaders.cpp shades);
 //   a ground quad; a camera node from the scene's camera;
 // - one animation "run": every sampler takes its keys from ONE accessor of the frames'

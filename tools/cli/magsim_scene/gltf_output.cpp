@@ -34,7 +34,7 @@ Counts counts(const engine::SceneDesc& s) {
     if (!b.visible) continue;
     for (const engine::ShapeDesc& sh : b.shapes) {
       c.shapes += 1;
-      distinct.emplace(static_cast<int>(sh.kind), sh.size.x(), sh.size.y(), sh.size.z(), b.color.r, b.color.g, b.color.b);
+      distinct.emplace(static_cast<int>(sh.kind), sh.size.x(), sh.size.y(), sh.size.z(), b.color.r, b.color.g, b.color.b);  // ≥ the file's
     }
   }
   c.meshes = static_cast<double>(distinct.size()) + 1;  // and the ground
