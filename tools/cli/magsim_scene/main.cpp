@@ -239,8 +239,9 @@ int main(int argc, char** argv) {
   app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
                                       "an output file could not be written",
                                       "Runs longer than 1e7 rigid steps are refused; so are runs whose estimated memory exceeds "
-                                      "MemAvailable or what ulimit -v leaves, scene files that are not regular "
-                                      "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
+                                      "MemAvailable or what ulimit -v leaves, --gltf files that could exceed glTF's 4 GiB, scene files "
+                                      "that are not regular files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x "
+                                      "the cores.\n" +
                                       std::string(tools::kMagsimKernelHelp) + "\n"
                                       "Every option flag has the range of its scene-file key (engine/options_table.cpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
