@@ -216,10 +216,10 @@ int run(const Args& a, const CLI::App& app) {
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
-  auto record = [&] {
+  auto record = [&] {  // a frame of states.csv is a frame of the glTF file, even when drawing it fails
     if (!rec.frame()) return;
-    painter.draw(sim);
     if (glb) glb->frame(sim);
+    painter.draw(sim);
   };
   std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters, threads;
   Ti.reserve(n_steps);
