@@ -13,6 +13,7 @@ checks:
 - one mesh datablock per distinct shape (kind, size, material), shared by all its objects;
 - one object per glTF node: bodies (as many as states.csv has), shapes, channel nodes, the
   ground and the camera;
+- every animated body keyed at exactly the frames of states.csv (frame t × fps);
 - the camera at the scene's eye, looking at its target (the camera node's extras);
 - with --channels: each body's "<body>.channels" object has Blender scale axis k = channel k,
   equal to the file's values at the checked frames, and, as a check independent of the file,
@@ -164,6 +165,25 @@ def main():
                 "camera: at the scene's eye, %.1e rad off the line to its target" % aim)
     else:
         c.check(False, "camera: none in the file")
+
+    # the keys: every animated body keyed at exactly the frames of states.csv, t × fps
+    want_keys = [t * key_fps for t, _ in frames]
+    keyed = off = 0
+    worst_key = 0.0
+    for o in bodies.values():
+        action = o.animation_data.action if o.animation_data else None
+        if action is None:
+            continue
+        keyed += 1
+        curve = action.fcurves.find("location", index=0)
+        keys = [k.co.x for k in curve.keyframe_points] if curve else []
+        if len(keys) != len(want_keys):
+            off += 1
+            continue
+        worst_key = max([worst_key] + [abs(a - b) for a, b in zip(keys, want_keys)])
+    c.check(off == 0 and worst_key <= 1e-4 * max(1.0, want_keys[-1]),
+            "keys: %d animated bodies keyed at the %d frames of states.csv (%d not; worst key %.1e frames off)" %
+            (keyed, len(want_keys), off, worst_key))
 
     # poses at the first, second, middle and last frame
     picks = sorted({0, min(1, len(frames) - 1), len(frames) // 2, len(frames) - 1})
