@@ -22,7 +22,7 @@ done
 
 PKGS=(build-essential cmake pkg-config git
       libode-dev libeigen3-dev libccd-dev catch2 libosmesa6-dev libpng-dev
-      nlohmann-json3-dev libcli11-dev ffmpeg fonts-dejavu-core
+      nlohmann-json3-dev libcli11-dev libtinygltf-dev ffmpeg fonts-dejavu-core
       python3 python3-matplotlib python3-numpy)
 missing=()
 for p in "${PKGS[@]}"; do

@@ -54,6 +54,8 @@ struct Args {
   tools::OptionFlags options;
   bool list = false;
   std::string write_scene;
+  std::string gltf;           ///< --gltf PATH.glb: the run as binary glTF (gltf_output.hpp)
+  std::string gltf_channels;  ///< --gltf-channels m_norm,speed,spin
 };
 
 
@@ -67,11 +69,12 @@ struct Args {
 struct MemoryNeed {
   double bodies = 0, moments = 0, shapes = 0;  // the scene's
   double steps = 0, frames = 0;                 // the run's
+  double recording = 0;                         // bytes held for --gltf (gltf_output.hpp)
   /// bytes: base + per body, moment and shape (ODE bodies, geoms and contacts, the model,
   /// state and magnetics workspace), per step (the timing series) and per recorded frame
   /// (summary.json's series)
   double bytes() const {
-    return 64.0 * (1 << 20) + 6144.0 * bodies + 2048.0 * (moments + shapes) + 80.0 * steps + 512.0 * frames;
+    return 64.0 * (1 << 20) + 6144.0 * bodies + 2048.0 * (moments + shapes) + 80.0 * steps + 512.0 * frames + recording;
   }
 };
 /// The scene's bodies, moments and shapes.

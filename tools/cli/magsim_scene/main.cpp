@@ -3,6 +3,7 @@
 #include "scenes/options_json.hpp"
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
+#include "tools/cli/magsim_scene/gltf_output.hpp"
 #include "tools/cli/magsim_scene/magsim_scene.hpp"
 
 #include <algorithm>
@@ -222,6 +223,14 @@ int main(int argc, char** argv) {
   app.add_option("--strength", a.strength, "multiplies every permanent moment")->check(tools::PositiveNumber);
   // the run options' flags, one per entry of the table that has one
   a.options.add(&app, "Options of the run (each overrides the scene's options.<key>; the scene file's ranges)");
+  app.add_option("--gltf", a.gltf,
+                 "also write the run as one binary glTF 2.0 file PATH.glb (y-up: magsim's (x, y, z) as (x, z, -y)): "
+                 "a node per body with its shapes, one animation keyed at the recorded frames' simulated times "
+                 "(those of states.csv), the camera and the ground; works with --no-render (tools/PROGRAMS.md)");
+  app.add_option("--gltf-channels", a.gltf_channels,
+                 "with --gltf: per-body values per frame, comma-separated, at most 3 of m_norm (|total moment|, "
+                 "A*m^2), speed (m/s), spin (rad/s); carried as the animated scale of a node <body>.channels, "
+                 "channel k on Blender's scale axis k");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
   app.add_option("--write-scene", a.write_scene,
                  "write the scene (with --count, --strength and the option flags applied) as a scene "
@@ -230,8 +239,9 @@ int main(int argc, char** argv) {
   app.footer(magsim::tools::exit_codes_footer("bad usage, flags or scene", "the simulation failed (summary.json holds the error)",
                                       "an output file could not be written",
                                       "Runs longer than 1e7 rigid steps are refused; so are runs whose estimated memory exceeds "
-                                      "MemAvailable or what ulimit -v leaves, scene files that are not regular "
-                                      "files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x the cores.\n" +
+                                      "MemAvailable or what ulimit -v leaves, --gltf files that could exceed glTF's 4 GiB, scene files "
+                                      "that are not regular files or are larger than 1 GiB, and OMP_NUM_THREADS above 4 x "
+                                      "the cores.\n" +
                                       std::string(tools::kMagsimKernelHelp) + "\n"
                                       "Every option flag has the range of its scene-file key (engine/options_table.cpp).\n"
                                       "SIGINT, SIGTERM, SIGHUP: the run finishes the step it is in, writes its outputs "
@@ -256,12 +266,15 @@ int main(int argc, char** argv) {
     return kBadInput;
   }
   // an empty name would be ignored (--write-scene) or fail as a folder (--out)
-  for (const auto& [flag, path] : {std::pair<const char*, const std::string&>{"--write-scene", a.write_scene}, {"--out", a.out}})
+  for (const auto& [flag, path] : {std::pair<const char*, const std::string&>{"--write-scene", a.write_scene}, {"--out", a.out}, {"--gltf", a.gltf}})
     if (app.count(flag) && path.empty()) {
       std::fprintf(stderr, "error: %s: needs a non-empty path\n", flag);
       return kBadInput;
     }
   try {
+    if (app.count("--gltf") && !ends_with(a.gltf, ".glb")) throw UsageError("--gltf: the path must end in .glb, got '" + a.gltf + "'");
+    if (app.count("--gltf-channels") && !app.count("--gltf")) throw UsageError("--gltf-channels needs --gltf");
+    if (app.count("--gltf-channels")) parse_gltf_channels(a.gltf_channels);
     if (app.count("--write-scene")) return write_scene(a, app);
     return run(a, app);
   } catch (const UsageError& e) {

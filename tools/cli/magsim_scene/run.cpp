@@ -13,6 +13,7 @@
 #include "scenes/options_json.hpp"
 #include "scenes/scene_file.hpp"
 #include "tools/cli/cpu_share.hpp"
+#include "tools/cli/magsim_scene/gltf_output.hpp"
 #include "tools/cli/magsim_scene/outputs.hpp"
 #include "tools/cli/replace_file.hpp"
 
@@ -153,6 +154,15 @@ int run(const Args& a, const CLI::App& app) {
     need.steps = app.count("--steps") ? static_cast<double>(a.steps)
                                       : std::min(kMaxSteps, std::max(1.0, secs / scene.options.dt));
     need.frames = std::min(need.steps, need.steps * a.fps * scene.options.dt) + 2;
+    if (!a.gltf.empty()) {
+      // --gltf: refused up front when the file would pass glTF's 4 GiB; its frames are held
+      // in memory until the end (a frame every max(1, round(1/(fps dt))) steps, first and last)
+      const double every = std::max(1.0, std::round(1.0 / (a.fps * scene.options.dt)));
+      const double frames = std::floor(need.steps / std::min(every, need.steps)) + 2;
+      const std::size_t channels = a.gltf_channels.empty() ? 0 : parse_gltf_channels(a.gltf_channels).size();
+      check_gltf_size(scene, frames, channels);
+      need.recording = gltf_memory(scene, frames, channels);
+    }
     check_memory("scene '" + scene.name + "'", need);
   }
   std::unique_ptr<engine::Simulation> sim_ptr;
@@ -201,9 +211,16 @@ int run(const Args& a, const CLI::App& app) {
   // (before, nothing of this run is on disk and the default action applies)
   catch_stop_signals();
   const OutDirLock lock = prepare_out_dir(dir);
+  std::unique_ptr<GltfOutput> glb;  // --gltf: its file is made now, so a bad path fails before the run
+  if (!a.gltf.empty()) glb = std::make_unique<GltfOutput>(a, model);
   FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
+  auto record = [&] {  // a frame of states.csv is a frame of the glTF file, even when drawing it fails
+    if (!rec.frame()) return;
+    if (glb) glb->frame(sim);
+    painter.draw(sim);
+  };
   std::vector<double> Ti, Tf, Tr, collide, quickstep, total, iters, threads;
   Ti.reserve(n_steps);
   Tf.reserve(n_steps);
@@ -225,7 +242,7 @@ int run(const Args& a, const CLI::App& app) {
   std::string io_error;  // the first failed write; the run stops there
   SlowStepNotice notice(static_cast<double>(scene.bodies.size()) >= kProgressBodies, scene.name + " " + method);
   try {
-    if (rec.frame()) painter.draw(sim);
+    record();
     for (long k = 0; k < n_steps; ++k) {
       if (g_stop_signal) break;
       if (adaptive) sim.limit_default_threads(governor.threads());
@@ -253,7 +270,7 @@ int run(const Args& a, const CLI::App& app) {
         deepest = sim.state().contact_depth;
         deepest_at = sim.time();
       }
-      if (sim.steps() % per_frame == 0 && rec.frame()) painter.draw(sim);
+      if (sim.steps() % per_frame == 0) record();
       const auto now = clock::now();
       if (now - last_report >= std::chrono::seconds(2)) {
         last_report = now;
@@ -265,7 +282,7 @@ int run(const Args& a, const CLI::App& app) {
                      p.cap_hit ? " (cap)" : "", sim.threads());
       }
     }
-    if (rec.frame()) painter.draw(sim);  // the final (or last good) state, if not yet drawn
+    record();  // the final (or last good) state, if not yet recorded
   } catch (const IoError& e) {
     io_error = e.what();
   }
@@ -282,6 +299,20 @@ int run(const Args& a, const CLI::App& app) {
   const double wall = std::chrono::duration<double>(clock::now() - t0).count();
   // a signal during the last step still marks the run: the summary then says what it saw
   const int stop = g_stop_signal;
+  json gltf_info = nullptr;
+  if (glb) {  // the frames there are, with the run's outcome in the asset's extras
+    const std::string err = !error.empty() ? error : io_error;
+    const json extras{{"scene", scene.name}, {"method", method}, {"frames", rec.frames()}, {"seconds", sim.time()},
+                      {"fps", a.fps}, {"complete", err.empty() && stop == 0},
+                      {"error", err.empty() ? json(nullptr) : json(err)}, {"interrupted", stop != 0},
+                      {"signal", stop ? json(signal_name(stop)) : json(nullptr)},
+                      {"axes", "y-up: magsim (x, y, z) is written as (x, z, -y)"}};
+    try {
+      gltf_info = {{"path", glb->path()}, {"bytes", glb->write(extras)}};
+    } catch (const IoError& e) {
+      if (io_error.empty()) io_error = e.what();
+    }
+  }
 
   const engine::Metrics fin = sim.metrics();
   char hash[19];
@@ -359,6 +390,7 @@ int run(const Args& a, const CLI::App& app) {
       {"energy", energy_json(sim)},
       {"series", rec.series()},
       {"state_hash", hash},
+      {"gltf", gltf_info},  // --gltf: the file and its size, null without it or when it failed
       // stopped by SIGINT, SIGTERM or SIGHUP after `steps` whole steps (the last good state)
       {"interrupted", stop != 0},
       {"signal", stop ? json(signal_name(stop)) : json(nullptr)},
