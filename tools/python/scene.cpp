@@ -97,6 +97,11 @@ void bind_scene(py::module_& m) {
         return keys;
       },
       "Every option's key in the scene file's spelling (\"magnetics.field.bh_theta\"), in the table's order.");
+  m.def(
+      "options_table",
+      [] { return py::module_::import("json").attr("loads")(scenes::table_json().dump()); },
+      "The table of options as magsim-scene --options-json prints it: one dict per option (key, kind, unit, "
+      "default, values, range or names, flag, doc).");
 
   py::class_<Scene>(m, "Scene", "A scene: bodies, magnets and options, as a scene file holds them.")
       .def_static(

@@ -72,3 +72,19 @@ def test_run_writes_the_cli_files(magsim, tmp_path, which):
         if key != "series":
             assert py[key] == cli[key], key
     assert py["series"]["time"] == cli["series"]["time"]
+
+
+def test_options_table_is_the_clis(magsim):
+    import json
+    import subprocess
+    from conftest import SCENE_BIN
+    cli = json.loads(subprocess.run([SCENE_BIN, "--options-json"], capture_output=True, text=True, check=True).stdout)
+    assert magsim.options_table() == cli
+    assert [o["key"] for o in cli] == magsim.option_keys()
+    # every option's default is what a fresh scene file gets
+    opts = magsim.Scene.from_json('{"bodies": []}').options
+    for o in cli:
+        at = opts
+        for part in o["key"].split("."):
+            at = at[part]
+        assert at == o["default"], o["key"]

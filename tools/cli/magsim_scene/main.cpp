@@ -178,6 +178,10 @@ int main(int argc, char** argv) {
   // the run options' flags, one per entry of the table that has one
   a.options.add(&app, "Options of the run (each overrides the scene's options.<key>; the scene file's ranges)");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
+  bool options_json = false;
+  app.add_flag("--options-json", options_json,
+               "print the table of options as JSON (key, kind, unit, default, range or names, flag, doc; "
+               "engine/options_table.cpp) and exit");
   app.add_option("--write-scene", a.write_scene,
                  "write the scene (with --count, --strength and the option flags applied) as a scene "
                  "FILE.json to edit and run, and exit without running");
@@ -200,6 +204,11 @@ int main(int argc, char** argv) {
   if (const std::string e = tools::magsim_kernel_error(); !e.empty()) {
     std::fprintf(stderr, "error: %s\n", e.c_str());
     return kBadInput;
+  }
+  if (options_json) {
+    errno = 0;
+    std::printf("%s\n", scenes::table_json().dump(1).c_str());
+    return tools::stdout_written("error: ", "the options") ? kOk : kIoError;
   }
   if (a.list) {
     errno = 0;

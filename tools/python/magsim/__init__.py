@@ -13,14 +13,15 @@ SimulationError(RuntimeError) for a failed step, OSError for I/O.
 """
 
 from magsim._errors import SceneError, SimulationError
-from magsim._magsim import HAVE_RENDER, Scene, Simulation, State, option_keys, scene_names
+from magsim._magsim import (HAVE_RENDER, Scene, Simulation, State, option_keys, options_table,
+                            scene_names)
 from magsim import _magsim
 
 if HAVE_RENDER:
     from magsim._magsim import Renderer
 
 __all__ = ["Scene", "Simulation", "State", "SceneError", "SimulationError", "scene_names",
-           "option_keys", "run", "HAVE_RENDER"] + (["Renderer"] if HAVE_RENDER else [])
+           "option_keys", "options_table", "run", "HAVE_RENDER"] + (["Renderer"] if HAVE_RENDER else [])
 
 
 def run(scene, out_dir, seconds=None, steps=None, fps=60.0, render=True, width=1280,
