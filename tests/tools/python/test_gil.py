@@ -20,7 +20,7 @@ def test_other_threads_run_during_step(magsim, small):
     t = threading.Thread(target=count)
     t.start()
     try:
-        sim.step(400)
+        sim.step(2000)
     finally:
         done.set()
         t.join()
@@ -33,7 +33,8 @@ def test_a_second_stepper_is_refused(magsim, small):
     errors = []
 
     def other():
-        time.sleep(0.05)
+        while sim.steps == 0:
+            time.sleep(0.001)
         try:
             sim.step(1)
         except RuntimeError as e:
@@ -41,7 +42,7 @@ def test_a_second_stepper_is_refused(magsim, small):
 
     t = threading.Thread(target=other)
     t.start()
-    sim.step(600)
+    sim.step(4000)
     t.join()
     assert errors and "busy" in errors[0]
 
@@ -62,3 +63,17 @@ def test_sigint_stops_after_a_whole_step(magsim):
     assert n > 0
     ref.step(n)
     assert ref.state_hash() == sim.state_hash()  # whole steps only
+
+
+def test_sigint_ends_magsim_run_with_whole_outputs(magsim, tmp_path):
+    import json
+    scene = magsim.Scene.from_registry("balls_up", count=200)
+    scene.set_option("threads", 1)
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        magsim.run(scene, tmp_path, seconds=100, fps=100, render=False)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["interrupted"] and s["signal"] == "SIGINT" and 0 < s["steps"] < 100000
+    rows = (tmp_path / "states.csv").read_text().splitlines()
+    assert len(rows) - 1 == s["frames"] * s["bodies"]
