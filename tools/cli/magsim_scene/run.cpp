@@ -295,7 +295,7 @@ int run_scene(const engine::SceneDesc& scene, const RunPlan& a) {
       {"modelling_level", scene.modelling_level},
       {"method", method},
       // the force actually used, in --force-model's spelling ("zeeman" = eq. 4)
-      {"force_model", mag::kForceModelNames.name(engine::resolved_force_model(model.options))},
+      {"force_model", mag::kForceModelNames.name(model.resolved.force)},
       // the run's options in the scene file's spelling (scenes/options_json.hpp): pasted into
       // a scene file as "options" they rerun this run
       {"options", scenes::to_json(model.options)},
