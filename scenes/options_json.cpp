@@ -183,6 +183,7 @@ json table_json() {
            {"kind", kKinds[static_cast<int>(s.kind)]},
            {"unit", s.unit},
            {"default", value_json(s, s.default_value())},
+           {"default_text", engine::value_text(s.default_value(), s.kind)},
            {"values", s.values_text()},
            {"flag", s.flag.empty() ? json(nullptr) : json(s.flag)},
            {"flag_switch", s.flag_switch},
