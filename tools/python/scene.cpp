@@ -123,8 +123,18 @@ void bind_scene(py::module_& m) {
             scenes::SceneParams p;
             p.count = count;
             p.strength = strength;
-            py::gil_scoped_release unlocked;
-            s.desc = e->build(p);
+            std::string error;
+            {
+              py::gil_scoped_release unlocked;
+              try {
+                // magsim-scene's refusal of a count that would not fit in memory
+                scene_tool::check_registry_memory(*e, p, name + " --count " + std::to_string(count));
+                s.desc = e->build(p);
+              } catch (const scene_tool::UsageError& x) {
+                error = x.what();
+              }
+            }
+            if (!error.empty()) raise_builtin(PyExc_ValueError, error);  // magsim-scene: exit 1
             return s;
           },
           py::arg("name"), py::arg("count") = 0, py::arg("strength") = 1.0,

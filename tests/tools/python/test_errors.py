@@ -71,3 +71,11 @@ def test_run_errors(magsim, tmp_path, small):
         magsim.run(magsim.Scene.from_file(str(INPUTS / "blow_up.json")), tmp_path / "b", steps=50, render=False)
     assert json.loads((tmp_path / "b" / "summary.json").read_text())["error"]
     assert os.path.exists(tmp_path / "b" / "states.csv")
+
+
+def test_a_count_that_cannot_fit_is_refused(magsim, tmp_path):
+    code, err = run_cli("balls_up", "--count", 1000000000, "--steps", 1, "--no-render", "--out", tmp_path, check=False)
+    assert code == 1
+    with pytest.raises(ValueError) as e:
+        magsim.Scene.from_registry("balls_up", count=1000000000)
+    assert str(e.value) == cli_error(err)

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "engine/scene_desc.hpp"
+#include "scenes/registry.hpp"
 #include "tools/cli/cli_common.hpp"
 #include "tools/cli/option_flags.hpp"
 
@@ -87,6 +88,9 @@ double memory_available(std::string* source);
 /// (...)" when need.bytes() exceeds memory_available(); prints a progress line for large
 /// scenes (from kProgressBodies bodies) with the estimate.
 void check_memory(const std::string& what, const MemoryNeed& need);
+/// check_memory for registry scene `e` built with p, before it is built: its size extrapolated
+/// from builds of 1 and 100 (a count of 1e8 would take tens of GB to describe).
+void check_registry_memory(const scenes::SceneEntry& e, const scenes::SceneParams& p, const std::string& what);
 /// From this many bodies magsim-scene says what it is doing while it reads and builds.
 constexpr double kProgressBodies = 20000;
 

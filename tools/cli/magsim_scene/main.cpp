@@ -20,13 +20,6 @@ namespace magsim::scene_tool {
 namespace scenes = magsim::scenes;
 namespace fs = std::filesystem;
 
-namespace {
-
-// registry scenes above this --count are sized from builds of 1 and of this many first
-constexpr int kSampleCount = 100;
-
-}  // namespace
-
 // The scene named on the command line, with the command line's overrides applied.
 engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
   engine::SceneDesc s;
@@ -51,21 +44,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     scenes::SceneParams p;
     if (app.count("--count")) p.count = a.count;
     if (app.count("--strength")) p.strength = a.strength;
-    if (p.count > kSampleCount) {
-      // the scene's own description would take memory in proportion to --count (1e8 balls:
-      // tens of GB before any check): its size is extrapolated from two small builds first
-      scenes::SceneParams small = p;
-      small.count = 1;
-      const MemoryNeed one = memory_need(e->build(small));
-      small.count = kSampleCount;
-      const MemoryNeed many = memory_need(e->build(small));
-      const double k = static_cast<double>(p.count - 1) / (kSampleCount - 1);
-      MemoryNeed need;
-      need.bodies = one.bodies + k * (many.bodies - one.bodies);
-      need.moments = one.moments + k * (many.moments - one.moments);
-      need.shapes = one.shapes + k * (many.shapes - one.shapes);
-      check_memory(a.scene + " --count " + std::to_string(p.count), need);
-    }
+    check_registry_memory(*e, p, a.scene + " --count " + std::to_string(p.count));
     s = e->build(p);
   }
   // the option flags given (the table's: engine/options_table.hpp); the scene's values stand

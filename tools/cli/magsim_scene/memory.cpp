@@ -94,4 +94,23 @@ void check_memory(const std::string& what, const MemoryNeed& need) {
                  avail >= 0 ? (", " + fmt(avail / gb) + " GB available").c_str() : "");
 }
 
+void check_registry_memory(const scenes::SceneEntry& e, const scenes::SceneParams& p, const std::string& what) {
+  // registry scenes above this count are sized from builds of 1 and of this many first
+  constexpr int kSampleCount = 100;
+  if (p.count <= kSampleCount) return;
+  // the scene's own description would take memory in proportion to the count (1e8 balls:
+  // tens of GB before any check): its size is extrapolated from two small builds first
+  scenes::SceneParams small = p;
+  small.count = 1;
+  const MemoryNeed one = memory_need(e.build(small));
+  small.count = kSampleCount;
+  const MemoryNeed many = memory_need(e.build(small));
+  const double k = static_cast<double>(p.count - 1) / (kSampleCount - 1);
+  MemoryNeed need;
+  need.bodies = one.bodies + k * (many.bodies - one.bodies);
+  need.moments = one.moments + k * (many.moments - one.moments);
+  need.shapes = one.shapes + k * (many.shapes - one.shapes);
+  check_memory(what, need);
+}
+
 }  // namespace magsim::scene_tool
