@@ -14,7 +14,7 @@ namespace magsim::engine {
 
 void compute_magnetic_forces(const Model& m, const mag::MomentDesc& set,
                              const mag::Magnetization& mz, Workspace* ws) {
-  mag::compute_forces(set, mz, resolved_force_model(m.options), mag::curve_of(m.options.magnetics.method),
+  mag::compute_forces(set, mz, m.resolved.force, m.resolved.curve,
                       m.options.magnetics.field, &ws->mag, &ws->F, &ws->tau, nullptr,
                       m.options.reaction_symmetric_forces);
 }

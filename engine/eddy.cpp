@@ -74,7 +74,7 @@ void apply_eddy_losses(const Model& m, const mag::MomentDesc& set,
   }
   ws->eddy_force.assign(m.nbody, Vec3::Zero());
   ws->eddy_torque.assign(m.nbody, Vec3::Zero());
-  const mag::Curve curve = mag::curve_of(m.options.magnetics.method);
+  const mag::Curve curve = m.resolved.curve;
   const std::vector<Vec3>& H = ws->mag.H;
   const std::vector<Mat3>& J = ws->mag.J;
   const bool have_prev = memory->h > 0.0 && memory->B.size() == set.size();

@@ -12,9 +12,8 @@ void magnetize(const Model& m, const mag::MomentDesc& set, mag::Magnetization* m
                Workspace* ws, StepProfile* prof) {
   if (m.induced_count == 0) return;  // nothing to magnetize: permanent moments only
   const mag::DynamicsOptions& opt = m.options.magnetics;
-  if (m.options.magnetics.method == mag::Method::Exact) {
-    const mag::ExactStats st =
-        mag::solve_exact(set, mz, mag::curve_of(mag::Method::Exact), opt.field);
+  if (m.resolved.exact) {
+    const mag::ExactStats st = mag::solve_exact(set, mz, m.resolved.curve, opt.field);
     prof->iterations += st.newton_steps;
     prof->converged = prof->converged && st.converged;
     prof->cap_hit = prof->cap_hit || !st.converged;

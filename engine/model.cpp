@@ -245,6 +245,10 @@ Model compile_model(const SceneDesc& scene) {
 
   Model m;
   m.options = scene.options;
+  m.resolved.curve = mag::curve_of(scene.options.magnetics.method);
+  m.resolved.force = resolved_force_model(scene.options);
+  m.resolved.exact = scene.options.magnetics.method == mag::Method::Exact;
+  m.resolved.force_has_energy = force_conservative(scene.options);
   m.H0 = scene.H0;
   if (const std::string e = camera_error(scene.camera); !e.empty()) fail("camera", e);
   m.camera = scene.camera;

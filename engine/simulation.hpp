@@ -66,6 +66,10 @@ class Simulation {
   const mag::MomentDesc& moments() const { return moments_; }
   const Model& model() const { return *model_; }
   const State& state() const { return state_; }
+  /// The step's scratch: the last step's magnetic forces per moment and body, and the fields
+  /// at the moments (ws.mag.H) of the evaluation at the committed state. Stale after a
+  /// restore_state until the next step.
+  const Workspace& workspace() const { return ws_; }
 
   int body_count() const;
   /// Index of the body with this name, −1 when none.

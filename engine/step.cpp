@@ -55,10 +55,10 @@ double Simulation::coenergy(const mag::Magnetization& mz) const {
   const Model& m = *model_;
   if (ws_.mag.H.size() != moments_.size()) return 0.0;
   // the potential of the force where it has its own (zeeman-total: E_sys, forces_total.hpp)
-  if (resolved_force_model(m.options) == mag::ForceModel::ZeemanTotal)
-    return mag::zeeman_total_energy(moments_, mz, mag::curve_of(m.options.magnetics.method), ws_.mag.H,
+  if (m.resolved.force == mag::ForceModel::ZeemanTotal)
+    return mag::zeeman_total_energy(moments_, mz, m.resolved.curve, ws_.mag.H,
                                     ws_.mag.total.perm, ws_.mag.total.Hp);
-  return mag::magnetic_coenergy(moments_, mz, mag::curve_of(m.options.magnetics.method), ws_.mag.H);
+  return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H);
 }
 
 void Simulation::solve_magnetics(mag::Magnetization* mz, bool solve, long n) {
@@ -210,7 +210,7 @@ void Simulation::step() {
   const long n = state_.step + 1;  // the step being taken, as named in errors
   const OmpThreadScope threads(omp_threads_);  // several Simulations may differ
   const SimOptions& o = m.options;
-  const bool guard = o.energy_guard && force_conservative(o);
+  const bool guard = o.energy_guard && m.resolved.force_has_energy;
 
   try {
     // (1b) the frame's rigid sub-steps (1 unless the scene allows more and bodies move fast)

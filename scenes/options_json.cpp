@@ -171,3 +171,30 @@ void from_json(const JsonReader& r, const json& j, const std::string& path, mag:
 }
 
 }  // namespace magsim::scenes
+
+namespace magsim::scenes {
+
+json table_json() {
+  static const char* const kKinds[] = {"number", "integer", "bool", "name", "vector"};
+  json rows = json::array();
+  for (const OptionSpec& s : engine::options_table()) {
+    json r{{"key", s.key},
+           {"old_key", s.old_key.empty() ? json(nullptr) : json(s.old_key)},
+           {"kind", kKinds[static_cast<int>(s.kind)]},
+           {"unit", s.unit},
+           {"default", value_json(s, s.default_value())},
+           {"default_text", engine::value_text(s.default_value(), s.kind)},
+           {"values", s.values_text()},
+           {"flag", s.flag.empty() ? json(nullptr) : json(s.flag)},
+           {"flag_switch", s.flag_switch},
+           {"doc", s.doc}};
+    if (s.kind == OptionKind::Number || s.kind == OptionKind::Integer || s.kind == OptionKind::Vector)
+      r["range"] = {{"integer", s.range.integer}, {"lo", s.range.lo}, {"hi", s.range.hi},
+                    {"lo_open", s.range.lo_open}, {"hi_open", s.range.hi_open}};
+    if (s.kind == OptionKind::Name) r["names"] = s.names;
+    rows.push_back(std::move(r));
+  }
+  return rows;
+}
+
+}  // namespace magsim::scenes

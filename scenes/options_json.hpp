@@ -27,6 +27,11 @@ void from_json(const JsonReader& r, const nlohmann::json& j, const std::string& 
 /// The same for a "magnetics" object (a scene file's options.magnetics: method, field, …).
 void from_json(const JsonReader& r, const nlohmann::json& j, const std::string& path, mag::DynamicsOptions* d);
 
+/// The table of options (engine/options_table.hpp) as JSON, one object per option in the
+/// table's order: key, old_key, kind (number, integer, bool, name, vector), unit, default (a
+/// JSON value) and default_text (as SCENE_FILE.md spells it), values (the text SCENE_FILE.md gives), flag, flag_switch, doc, and
+/// range {integer, lo, hi, lo_open, hi_open} or names. magsim-scene --options-json prints it.
+nlohmann::json table_json();
 /// [x, y, z]: how scene files, summary.json and the options write a vector.
 inline nlohmann::json vec3_json(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 

@@ -160,7 +160,9 @@ int run(int argc, char** argv) {
                  "(magnetics: a scene file's options.magnetics; the flags below override it)")
       ->required();
   app.add_option("--method", method_name, mag::kMethodNames.list("|"))->capture_default_str();
-  app.add_option("--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6]")
+  // one spelling per option in every program (magsim-scene's, engine/options_table.cpp); the
+  // older spellings of magsolve stay as aliases
+  app.add_option("--dt-m,--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6] (--dt: the older spelling)")
       ->check(magsim::tools::OptionCheck("magnetics.dt"))->capture_default_str();
   app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration, in (0, 1)")
       ->check(magsim::tools::OptionCheck("magnetics.tol"))->capture_default_str();
@@ -182,9 +184,10 @@ int run(int argc, char** argv) {
                      " (pair: exact two-sphere couplings faded by saturation, magnetics/near_field.hpp; "
                      "it changes M, H and every force printed, and needs the classic F_model)")
       ->capture_default_str();
-  app.add_option("--mu-r", mu_r, "initial relative permeability of the induced material, read by "
-                                 "--near-field pair, in [10, 10000] (iron: 1000)")
-      ->capture_default_str();
+  app.add_option("--near-field-mu-r,--mu-r", mu_r,
+                 "initial relative permeability of the induced material, read by --near-field pair, in "
+                 "[10, 10000] (iron: 1000) (--mu-r: the older spelling)")
+      ->check(magsim::tools::OptionCheck("magnetics.field.near_field.mu_r"))->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
   app.footer(magsim::tools::exit_codes_footer(
@@ -239,14 +242,14 @@ int run(int argc, char** argv) {
     if (doc.contains("magnetics")) magsim::scenes::from_json(r, doc["magnetics"], "magnetics", &opt);
     // flags given on the command line override the case's "magnetics"
     if (app.count("--method")) mag::parse_method(method_name, &opt.method);  // a valid name: checked above
-    if (app.count("--dt")) opt.dt = dt;
+    if (app.count("--dt-m")) opt.dt = dt;
     if (app.count("--tol")) opt.tol = tol;
     if (app.count("--max-iter")) opt.max_iter = max_iter;
     if (app.count("--softening")) opt.field.softening = softening;
     if (app.count("--near-field") &&
         !mag::kNearFieldNames.parse(near_field_name, &opt.field.near_field.model))
       throw InputError(mag::kNearFieldNames.unknown("--near-field", near_field_name));
-    if (app.count("--mu-r")) opt.field.near_field.mu_r = mu_r;
+    if (app.count("--near-field-mu-r")) opt.field.near_field.mu_r = mu_r;
     if (const std::string e = mag::validate(opt); !e.empty()) {
       std::fprintf(stderr, "magsolve: %s\n", e.c_str());
       return kBadInput;

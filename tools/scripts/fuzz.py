@@ -386,20 +386,15 @@ def fam_concurrent(rng, out, timeout):
 
 def option_table():
     """The number options that have a flag: (key, flag, integer, lo, hi, lo_open, hi_open), from
-    scenes/SCENE_FILE.md's options table, which tests/engine/options_table_test.cpp holds to
-    the table in engine/options_table.cpp."""
-    text = open(os.path.join(ROOT, "scenes/SCENE_FILE.md")).read()
+    the table of options as magsim-scene --options-json prints it (engine/options_table.cpp)."""
+    p = subprocess.run([SCENE, "--options-json"], capture_output=True, text=True, timeout=60)
+    if p.returncode != 0:
+        sys.exit(f"fuzz.py: {SCENE} --options-json: exit {p.returncode}: {p.stderr.strip()}")
     rows = []
-    num = lambda t: float(t)
-    row = re.compile(r"^\| `([a-z_.]+)` \| [^|]* \| an? (integer|number) (.*?) \| `(--[a-z-]+)` \|", re.M)
-    for m in row.finditer(text):
-        key, integer, values, flag = m.group(1), m.group(2) == "integer", m.group(3), m.group(4)
-        b = re.fullmatch(r"in ([\[(])([^,]+), ([^\])]+)([\])])", values)
-        h = re.fullmatch(r"(>=|>) (\S+) and finite", values)
-        if b:
-            rows.append((key, flag, integer, num(b.group(2)), num(b.group(3)), b.group(1) == "(", b.group(4) == ")"))
-        elif h:
-            rows.append((key, flag, integer, num(h.group(2)), sys.float_info.max, h.group(1) == ">", False))
+    for o in json.loads(p.stdout):
+        if o["kind"] in ("number", "integer") and o["flag"]:
+            r = o["range"]
+            rows.append((o["key"], o["flag"], r["integer"], float(r["lo"]), float(r["hi"]), r["lo_open"], r["hi_open"]))
     return rows
 
 
@@ -487,14 +482,14 @@ def main():
     a = ap.parse_args()
     global SCENE, SOLVE
     SCENE, SOLVE = os.path.join(a.bin, "magsim-scene"), os.path.join(a.bin, "magsolve")
-    OPTIONS.extend(option_table())
-    if not OPTIONS:
-        sys.exit("fuzz.py: no options found in scenes/SCENE_FILE.md")
     if not (a.seconds > 0 and a.count > 0 and a.timeout > 0):
         ap.error("--seconds, --count and --timeout must be > 0")
     for b in (SCENE, SOLVE):
         if not os.access(b, os.X_OK):
             sys.exit(f"fuzz.py: {b} not built (run tools/scripts/setup.sh --no-demo)")
+    OPTIONS.extend(option_table())
+    if not OPTIONS:
+        sys.exit("fuzz.py: no number options with a flag in magsim-scene --options-json")
     os.makedirs(a.out, exist_ok=True)
     rng = random.Random(a.seed)
     t0 = time.monotonic()

@@ -23,7 +23,7 @@ done
 PKGS=(build-essential cmake pkg-config git
       libode-dev libeigen3-dev libccd-dev catch2 libosmesa6-dev libpng-dev
       nlohmann-json3-dev libcli11-dev libtinygltf-dev ffmpeg fonts-dejavu-core
-      python3 python3-matplotlib python3-numpy)
+      python3 python3-matplotlib python3-numpy python3-dev python3-pytest pybind11-dev)
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")

@@ -98,7 +98,7 @@ double gltf_memory(const engine::SceneDesc& scene, double frames, std::size_t ch
 
 namespace {
 
-gltf::SceneInfo scene_info(const Args& a, const engine::Model& m, const std::vector<std::string>& channels) {
+gltf::SceneInfo scene_info(const RunPlan& a, const engine::Model& m, const std::vector<std::string>& channels) {
   gltf::SceneInfo s;
   s.name = m.name;
   s.channels = channels;
@@ -156,7 +156,7 @@ gltf::GlbFile open_file(const std::string& path) {
 
 }  // namespace
 
-GltfOutput::GltfOutput(const Args& a, const engine::Model& m)
+GltfOutput::GltfOutput(const RunPlan& a, const engine::Model& m)
     : model_(m), scene_(scene_info(a, m, a.gltf_channels.empty() ? std::vector<std::string>{} : parse_gltf_channels(a.gltf_channels))),
       rec_(scene_),
       file_(open_file(a.gltf)) {

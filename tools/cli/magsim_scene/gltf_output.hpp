@@ -30,7 +30,7 @@ class GltfOutput {
  public:
   /// Makes the file's temporary beside a.gltf (UsageError: not a regular file; IoError: it
   /// cannot be made).
-  GltfOutput(const Args& a, const engine::Model& m);
+  GltfOutput(const RunPlan& a, const engine::Model& m);
   /// Records the simulation's current state as the next frame.
   void frame(const engine::Simulation& sim);
   /// Writes the file with `extras` as the asset's extras; returns its size. IoError when it

@@ -1,15 +1,19 @@
 // tools/cli/magsim_scene/magsim_scene.hpp — what the files of magsim-scene share: the
 // command-line arguments, the errors that pick the exit code, and the entry points
-// (main.cpp: flags and the scene they name; run.cpp: the run and --write-scene;
-// outputs.hpp/.cpp: summary.json's parts, states.csv, moments.csv, frames).
+// (main.cpp: flags, the scene they name and --write-scene; run.cpp: the run;
+// outputs.hpp/.cpp: summary.json's parts, states.csv, moments.csv, frames; memory.cpp: the
+// memory estimate). run.cpp, outputs.cpp and memory.cpp are the library magsim_scene_run,
+// which the Python module's magsim.run links too, so both write the same files.
 #pragma once
 
 #include "engine/scene_desc.hpp"
+#include "scenes/registry.hpp"
 #include "tools/cli/cli_common.hpp"
 #include "tools/cli/option_flags.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -87,6 +91,9 @@ double memory_available(std::string* source);
 /// (...)" when need.bytes() exceeds memory_available(); prints a progress line for large
 /// scenes (from kProgressBodies bodies) with the estimate.
 void check_memory(const std::string& what, const MemoryNeed& need);
+/// check_memory for registry scene `e` built with p, before it is built: its size extrapolated
+/// from builds of 1 and 100 (a count of 1e8 would take tens of GB to describe).
+void check_registry_memory(const scenes::SceneEntry& e, const scenes::SceneParams& p, const std::string& what);
 /// From this many bodies magsim-scene says what it is doing while it reads and builds.
 constexpr double kProgressBodies = 20000;
 
@@ -97,9 +104,36 @@ std::string registry_names();
 /// The scene named on the command line, with the command line's overrides applied
 /// (main.cpp); throws UsageError.
 engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app);
-/// The run: summary.json, states.csv, moments.csv and frames into --out (run.cpp).
+/// What a run does besides its scene: magsim-scene's flags (main.cpp) or magsim.run's
+/// arguments (tools/python/).
+struct RunPlan {
+  std::string source = "registry";  ///< the scene file or "registry": summary.json "source"; outputs never overwrite a *.json source
+  int count = 0;                    ///< summary.json "params"
+  double strength = 1.0;
+  long steps = 0;                   ///< > 0: this many rigid steps
+  double seconds = 0.0;             ///< > 0 (and steps = 0): this long; neither: the scene's default_seconds
+  std::string out;                  ///< the output folder; "" = out/<scene>_<method>
+  double fps = 60.0;
+  bool render = true;
+  bool arrows = false;
+  int width = 1280, height = 720, samples = 1;
+  std::string gltf;           ///< "" or the binary glTF file to write (gltf_output.hpp)
+  std::string gltf_channels;  ///< per-body channels of that file, comma-separated
+  /// Polled before each step: a signal number ends the run as that signal would (whole rows,
+  /// summary.json "interrupted"). Unset: SIGINT, SIGTERM and SIGHUP are caught for the run.
+  std::function<int()> stop;
+  /// When set, receives the one-line error of a failed run (exit 2 or 3).
+  std::string* error = nullptr;
+};
+/// The run: summary.json, states.csv, moments.csv and frames into plan.out (run.cpp). Returns
+/// the exit code (kRunFailed: a SimulationError; kIoError; 128 + a stop signal); throws
+/// UsageError and IoError as magsim-scene's exit 1 and 3.
+int run_scene(const engine::SceneDesc& scene, const RunPlan& plan);
+/// The scene as --write-scene writes it: the scene file's JSON, one space a level, a final newline.
+std::string scene_file_text(const engine::SceneDesc& scene);
+/// The run the command line names (main.cpp).
 int run(const Args& a, const CLI::App& app);
-/// --write-scene FILE (run.cpp).
+/// --write-scene FILE (main.cpp).
 int write_scene(const Args& a, const CLI::App& app);
 
 }  // namespace magsim::scene_tool

@@ -4,6 +4,7 @@
 #include "scenes/registry.hpp"
 #include "scenes/scene_file.hpp"
 #include "tools/cli/magsim_scene/gltf_output.hpp"
+#include "tools/cli/replace_file.hpp"
 #include "tools/cli/magsim_scene/magsim_scene.hpp"
 
 #include <algorithm>
@@ -14,100 +15,11 @@
 #include <filesystem>
 #include <utility>
 
-#include <sys/resource.h>
 
 namespace magsim::scene_tool {
 
 namespace scenes = magsim::scenes;
 namespace fs = std::filesystem;
-
-std::string fmt(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", x);
-  return b;
-}
-
-
-bool ends_with(const std::string& s, const std::string& tail) {
-  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-
-std::string registry_names() {
-  std::string names;
-  for (const scenes::SceneEntry& e : scenes::registry()) names += (names.empty() ? "" : ", ") + std::string(e.name);
-  return names;
-}
-
-
-MemoryNeed memory_need(const engine::SceneDesc& s) {
-  MemoryNeed n;
-  n.bodies = static_cast<double>(s.bodies.size());
-  for (const engine::BodyDesc& b : s.bodies) {
-    n.moments += static_cast<double>(b.moments.size());
-    n.shapes += static_cast<double>(b.shapes.size());
-  }
-  return n;
-}
-
-double memory_available(std::string* source) {
-  double avail = -1;
-  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
-    char line[256];
-    while (std::fgets(line, sizeof line, f)) {
-      unsigned long long kb = 0;
-      if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
-        avail = static_cast<double>(kb) * 1024.0;
-        *source = "MemAvailable";
-        break;
-      }
-    }
-    std::fclose(f);
-  }
-  struct rlimit rl {};
-  if (::getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
-    double mapped = 0;  // VmSize: what the address-space limit already counts
-    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
-      char line[256];
-      unsigned long long kb = 0;
-      while (std::fgets(line, sizeof line, f))
-        if (std::sscanf(line, "VmSize: %llu kB", &kb) == 1) mapped = static_cast<double>(kb) * 1024.0;
-      std::fclose(f);
-    }
-    const double left = std::max(0.0, static_cast<double>(rl.rlim_cur) - mapped);
-    if (avail < 0 || left < avail) {
-      avail = left;
-      *source = "the address-space limit (ulimit -v)";
-    }
-  }
-  return avail;
-}
-
-void check_memory(const std::string& what, const MemoryNeed& need) {
-  std::string source;
-  const double avail = memory_available(&source);
-  const double gb = 1e9;
-  char detail[256];
-  std::snprintf(detail, sizeof detail, "%.0f bodies, %.0f moments, %.0f shapes", need.bodies, need.moments, need.shapes);
-  if (need.steps > 0) std::snprintf(detail + std::strlen(detail), sizeof detail - std::strlen(detail), ", %.0f steps", need.steps);
-  if (avail >= 0 && need.bytes() > avail) {
-    char msg[512];
-    std::snprintf(msg, sizeof msg, "%s: needs about %.2f GB of memory (%s; estimated, magsim_scene.hpp MemoryNeed), "
-                  "more than the %.2f GB available (%s)", what.c_str(), need.bytes() / gb, detail, avail / gb, source.c_str());
-    throw UsageError(msg);
-  }
-  if (need.bodies >= kProgressBodies)
-    std::fprintf(stderr, "%s: %s; about %.2f GB of memory estimated%s\n", what.c_str(), detail, need.bytes() / gb,
-                 avail >= 0 ? (", " + fmt(avail / gb) + " GB available").c_str() : "");
-}
-
-
-namespace {
-
-// registry scenes above this --count are sized from builds of 1 and of this many first
-constexpr int kSampleCount = 100;
-
-}  // namespace
 
 // The scene named on the command line, with the command line's overrides applied.
 engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
@@ -133,21 +45,7 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
     scenes::SceneParams p;
     if (app.count("--count")) p.count = a.count;
     if (app.count("--strength")) p.strength = a.strength;
-    if (p.count > kSampleCount) {
-      // the scene's own description would take memory in proportion to --count (1e8 balls:
-      // tens of GB before any check): its size is extrapolated from two small builds first
-      scenes::SceneParams small = p;
-      small.count = 1;
-      const MemoryNeed one = memory_need(e->build(small));
-      small.count = kSampleCount;
-      const MemoryNeed many = memory_need(e->build(small));
-      const double k = static_cast<double>(p.count - 1) / (kSampleCount - 1);
-      MemoryNeed need;
-      need.bodies = one.bodies + k * (many.bodies - one.bodies);
-      need.moments = one.moments + k * (many.moments - one.moments);
-      need.shapes = one.shapes + k * (many.shapes - one.shapes);
-      check_memory(a.scene + " --count " + std::to_string(p.count), need);
-    }
+    check_registry_memory(*e, p, a.scene + " --count " + std::to_string(p.count));
     s = e->build(p);
   }
   // the option flags given (the table's: engine/options_table.hpp); the scene's values stand
@@ -163,6 +61,44 @@ engine::SceneDesc resolve_scene(const Args& a, const CLI::App& app) {
                      "at most " + std::to_string(tools::max_threads()) + " (4 x the " +
                      std::to_string(tools::max_threads() / 4) + " cores), got " + std::to_string(s.options.threads));
   return s;
+}
+
+
+// The run of the scene the command line names, as its flags plan it (run.cpp).
+int run(const Args& a, const CLI::App& app) {
+  RunPlan plan;
+  const engine::SceneDesc scene = resolve_scene(a, app);
+  plan.source = a.scene;
+  plan.count = a.count;
+  if (app.count("--strength")) plan.strength = a.strength;
+  if (app.count("--steps")) plan.steps = a.steps;
+  if (app.count("--seconds")) plan.seconds = a.seconds;
+  plan.out = a.out;
+  plan.fps = a.fps;
+  plan.render = !a.no_render;
+  plan.arrows = a.arrows;
+  plan.width = a.width;
+  plan.height = a.height;
+  plan.samples = a.samples;
+  plan.gltf = a.gltf;
+  plan.gltf_channels = a.gltf_channels;
+  return run_scene(scene, plan);
+}
+
+// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written whole
+// through a temporary file (tools/cli/replace_file.hpp): a regular file or a symlink to one is
+// replaced, a missing one created; a directory, device, FIFO or dangling link is refused.
+int write_scene(const Args& a, const CLI::App& app) {
+  const engine::SceneDesc scene = resolve_scene(a, app);
+  try {
+    tools::replace_file(a.write_scene, scene_file_text(scene));
+  } catch (const tools::NotARegularFile& e) {
+    throw UsageError("--write-scene " + a.write_scene + ": " + e.what());
+  } catch (const tools::WriteFailed& e) {
+    throw IoError("--write-scene: cannot write " + a.write_scene + ": " + e.what());
+  }
+  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), a.write_scene.c_str());
+  return kOk;
 }
 
 
@@ -232,6 +168,10 @@ int main(int argc, char** argv) {
                  "A*m^2), speed (m/s), spin (rad/s); carried as the animated scale of a node <body>.channels, "
                  "channel k on Blender's scale axis k");
   app.add_flag("--list", a.list, "list the registry's scenes and exit");
+  bool options_json = false;
+  app.add_flag("--options-json", options_json,
+               "print the table of options as JSON (key, kind, unit, default, range or names, flag, doc; "
+               "engine/options_table.cpp) and exit");
   app.add_option("--write-scene", a.write_scene,
                  "write the scene (with --count, --strength and the option flags applied) as a scene "
                  "FILE.json to edit and run, and exit without running");
@@ -255,6 +195,11 @@ int main(int argc, char** argv) {
   if (const std::string e = tools::magsim_kernel_error(); !e.empty()) {
     std::fprintf(stderr, "error: %s\n", e.c_str());
     return kBadInput;
+  }
+  if (options_json) {
+    errno = 0;
+    std::printf("%s\n", scenes::table_json().dump(1).c_str());
+    return tools::stdout_written("error: ", "the options") ? kOk : kIoError;
   }
   if (a.list) {
     errno = 0;

@@ -121,7 +121,7 @@ json energy_json(const engine::Simulation& sim) {
   j["created"] = e.total.energy_created;
   j["dissipated"] = e.total.energy_dissipated;
   const engine::SimOptions& o = sim.model().options;
-  const bool conservative = engine::force_conservative(o);
+  const bool conservative = sim.model().resolved.force_has_energy;
   j["conservative"] = conservative;
   j["guard"] = {{"enabled", o.energy_guard && conservative},
                 {"available", conservative},

@@ -179,16 +179,16 @@ class Recorder {
 // background thread. crystal_balls (or --arrows) draws M1 (red) and M2 (blue) on every ball.
 class FrameRenderer {
  public:
-  FrameRenderer(const Args& a, const std::string& dir, bool arrows)
-      : dir_(dir), enabled_(!a.no_render) {
+  FrameRenderer(bool render, int width, int height, int samples, const std::string& dir, bool arrows)
+      : dir_(dir), enabled_(render) {
     if (!enabled_) return;
 #ifdef MAGSIM_HAVE_RENDER
-    renderer_ = std::make_unique<magsim::render::Renderer>(a.width, a.height, a.samples);
+    renderer_ = std::make_unique<magsim::render::Renderer>(width, height, samples);
     writer_ = std::make_unique<magsim::render::FrameWriter>(4, 1);
     opts_.magnetization_arrows = arrows;
     opts_.arrow_scale = 2.2;  // reach out of the ball to be seen
 #else
-    (void)arrows;
+    (void)width, (void)height, (void)samples, (void)arrows;
     std::fprintf(stderr, "note: built without the renderer (MAGSIM_RENDER=OFF); continuing as --no-render\n");
     enabled_ = false;
 #endif

@@ -138,20 +138,19 @@ class SlowStepNotice {
 
 }  // namespace
 
-int run(const Args& a, const CLI::App& app) {
+int run_scene(const engine::SceneDesc& scene, const RunPlan& a) {
   // busy machines (cpu_share.hpp): unless the user fixed the thread count (--threads, the scene
   // file's options.threads or OMP_NUM_THREADS), the magnetics use as many threads as the other
   // processes leave cores free; the first window of the estimate is the scene's set-up
   const unsigned cores = std::thread::hardware_concurrency();
   engine::ThreadGovernor governor(cores > 0 ? static_cast<int>(cores) : 1);  // Simulation caps it at its own count
-  engine::SceneDesc scene = resolve_scene(a, app);
   const std::string method = mag::method_name(scene.options.magnetics.method);
   {
     // the memory the run will take, refused up front when it will not fit (magsim_scene.hpp);
     // the steps as below, bounded by kMaxSteps (a longer run is refused there)
     MemoryNeed need = memory_need(scene);
-    const double secs = app.count("--seconds") ? a.seconds : scene.default_seconds;
-    need.steps = app.count("--steps") ? static_cast<double>(a.steps)
+    const double secs = a.seconds > 0 ? a.seconds : scene.default_seconds;
+    need.steps = a.steps > 0 ? static_cast<double>(a.steps)
                                       : std::min(kMaxSteps, std::max(1.0, secs / scene.options.dt));
     need.frames = std::min(need.steps, need.steps * a.fps * scene.options.dt) + 2;
     if (!a.gltf.empty()) {
@@ -182,8 +181,8 @@ int run(const Args& a, const CLI::App& app) {
 
   // the run's length, checked in double before any conversion to long
   long n_steps = a.steps;
-  if (!app.count("--steps")) {
-    const bool flag = app.count("--seconds") > 0;
+  if (a.steps <= 0) {
+    const bool flag = a.seconds > 0;
     const double seconds = flag ? a.seconds : scene.default_seconds;
     const std::string what = flag ? "--seconds " + fmt(seconds) : "the scene's default_seconds " + fmt(seconds);
     if (seconds < dt * (1 - 1e-9))
@@ -199,21 +198,23 @@ int run(const Args& a, const CLI::App& app) {
   // a frame every per_frame steps; below one frame per run only the first and last are kept
   const double frame_steps = 1.0 / (a.fps * dt);
   const long per_frame = frame_steps >= static_cast<double>(n_steps) ? n_steps : std::max(1L, std::lround(frame_steps));
-  const std::string dir = app.count("--out") ? a.out : "out/" + scene.name + "_" + method;
+  const std::string dir = !a.out.empty() ? a.out : "out/" + scene.name + "_" + method;
   // summary.json must not overwrite the scene file it was made from (--out = its folder)
-  if (ends_with(a.scene, ".json"))
+  if (ends_with(a.source, ".json"))
     for (const char* n : kOutputNames) {
       std::error_code ec;
-      if (fs::equivalent(fs::path(dir) / n, a.scene, ec))
-        throw UsageError("--out " + dir + ": the output " + n + " would overwrite the input scene file " + a.scene);
+      if (fs::equivalent(fs::path(dir) / n, a.source, ec))
+        throw UsageError("--out " + dir + ": the output " + n + " would overwrite the input scene file " + a.source);
     }
   // from here on the folder is touched: a stop signal ends the run cleanly, not the process
-  // (before, nothing of this run is on disk and the default action applies)
-  catch_stop_signals();
+  // (before, nothing of this run is on disk and the default action applies); a caller that
+  // polls for its own stop (the Python module) keeps its handlers
+  if (!a.stop) catch_stop_signals();
+  auto stop_requested = [&a]() -> int { return a.stop ? a.stop() : static_cast<int>(g_stop_signal); };
   const OutDirLock lock = prepare_out_dir(dir);
   std::unique_ptr<GltfOutput> glb;  // --gltf: its file is made now, so a bad path fails before the run
   if (!a.gltf.empty()) glb = std::make_unique<GltfOutput>(a, model);
-  FrameRenderer painter(a, dir, a.arrows || scene.name == "crystal_balls");
+  FrameRenderer painter(a.render, a.width, a.height, a.samples, dir, a.arrows || scene.name == "crystal_balls");
 
   Recorder rec(dir, sim);
   auto record = [&] {  // a frame of states.csv is a frame of the glTF file, even when drawing it fails
@@ -244,7 +245,7 @@ int run(const Args& a, const CLI::App& app) {
   try {
     record();
     for (long k = 0; k < n_steps; ++k) {
-      if (g_stop_signal) break;
+      if (stop_requested()) break;
       if (adaptive) sim.limit_default_threads(governor.threads());
       threads.push_back(sim.threads());
       try {
@@ -298,7 +299,7 @@ int run(const Args& a, const CLI::App& app) {
   }
   const double wall = std::chrono::duration<double>(clock::now() - t0).count();
   // a signal during the last step still marks the run: the summary then says what it saw
-  const int stop = g_stop_signal;
+  const int stop = stop_requested();
   json gltf_info = nullptr;
   if (glb) {  // the frames there are, with the run's outcome in the asset's extras
     const std::string err = !error.empty() ? error : io_error;
@@ -320,12 +321,12 @@ int run(const Args& a, const CLI::App& app) {
   auto stats = [](const std::vector<double>& v) { return json{{"median", median(v)}, {"total", sum(v)}}; };
   json summary{
       {"scene", scene.name},
-      {"source", ends_with(a.scene, ".json") ? a.scene : "registry"},
+      {"source", ends_with(a.source, ".json") ? a.source : "registry"},
       {"description", scene.description},
       {"modelling_level", scene.modelling_level},
       {"method", method},
       // the force actually used, in --force-model's spelling ("zeeman" = eq. 4)
-      {"force_model", mag::kForceModelNames.name(engine::resolved_force_model(model.options))},
+      {"force_model", mag::kForceModelNames.name(model.resolved.force)},
       // the run's options in the scene file's spelling (scenes/options_json.hpp): pasted into
       // a scene file as "options" they rerun this run
       {"options", scenes::to_json(model.options)},
@@ -333,7 +334,7 @@ int run(const Args& a, const CLI::App& app) {
                                                                         static_cast<std::size_t>(model.nmoment)))},
       {"contact_margin_used", model.contact_margin},
       {"H0", scenes::vec3_json(model.H0)},
-      {"params", {{"count", a.count}, {"strength", app.count("--strength") ? a.strength : 1.0}}},
+      {"params", {{"count", a.count}, {"strength", a.strength}}},
       {"escape_radius", model.escape_radius},
       {"bodies", model.nbody},
       {"dynamic_bodies", model.dynamic_bodies.size()},
@@ -406,6 +407,7 @@ int run(const Args& a, const CLI::App& app) {
                  io_error.empty() ? "" : "; before that: ", tools::one_line(io_error).c_str());
     return kIoError;
   }
+  if (a.error) *a.error = !io_error.empty() ? io_error : error;
   if (!io_error.empty()) {
     std::fprintf(stderr, "error: %s\n(summary with the error in %s)\n", tools::one_line(io_error).c_str(), path.c_str());
     return kIoError;
@@ -431,20 +433,6 @@ int run(const Args& a, const CLI::App& app) {
 }
 
 
-// --write-scene FILE: the resolved scene as a scene file (scenes::scene_to_json), written whole
-// through a temporary file (tools/cli/replace_file.hpp): a regular file or a symlink to one is
-// replaced, a missing one created; a directory, device, FIFO or dangling link is refused.
-int write_scene(const Args& a, const CLI::App& app) {
-  const engine::SceneDesc scene = resolve_scene(a, app);
-  try {
-    tools::replace_file(a.write_scene, scenes::scene_to_json(scene).dump(1) + "\n");
-  } catch (const tools::NotARegularFile& e) {
-    throw UsageError("--write-scene " + a.write_scene + ": " + e.what());
-  } catch (const tools::WriteFailed& e) {
-    throw IoError("--write-scene: cannot write " + a.write_scene + ": " + e.what());
-  }
-  std::fprintf(stderr, "%s: %zu bodies written to %s\n", scene.name.c_str(), scene.bodies.size(), a.write_scene.c_str());
-  return kOk;
-}
+std::string scene_file_text(const engine::SceneDesc& scene) { return scenes::scene_to_json(scene).dump(1) + "\n"; }
 
 }  // namespace magsim::scene_tool
