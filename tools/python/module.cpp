@@ -47,7 +47,7 @@ void bind_outputs(py::module_& m) {
   m.def(
       "_run",
       [](const Scene& scene, const std::string& out, long steps, double seconds, double fps, bool render, int width,
-         int height, int samples, bool arrows) {
+         int height, int samples, bool arrows, const std::string& gltf, const std::string& gltf_channels) {
         scene_tool::RunPlan plan;
         plan.source = scene.source;
         plan.count = scene.count;
@@ -61,6 +61,8 @@ void bind_outputs(py::module_& m) {
         plan.width = width;
         plan.height = height;
         plan.samples = samples;
+        plan.gltf = gltf;
+        plan.gltf_channels = gltf_channels;
         std::string error;
         plan.error = &error;
         // Ctrl-C: the run stops after the step in progress with its outputs whole, and the
@@ -96,7 +98,8 @@ void bind_outputs(py::module_& m) {
         return code;
       },
       py::arg("scene"), py::arg("out"), py::arg("steps"), py::arg("seconds"), py::arg("fps"), py::arg("render"),
-      py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("arrows"));
+      py::arg("width"), py::arg("height"), py::arg("samples"), py::arg("arrows"), py::arg("gltf") = "",
+      py::arg("gltf_channels") = "");
 
 #ifdef MAGSIM_HAVE_RENDER
   py::class_<render::Renderer>(m, "Renderer", "The offscreen OSMesa renderer of magsim-scene's frames.")

@@ -88,3 +88,20 @@ def test_options_table_is_the_clis(magsim):
         for part in o["key"].split("."):
             at = at[part]
         assert at == o["default"], o["key"]
+
+
+def test_run_writes_the_clis_gltf(magsim, tmp_path):
+    """magsim.run(gltf=...) writes magsim-scene's --gltf file: the same glb, byte for byte,
+    but for the asset's extras that name nothing run-specific beyond the outcome."""
+    scene = magsim.Scene.from_file(str(TWO_BALLS))
+    scene.set_option("threads", 1)
+    cli_summary(tmp_path / "cli", TWO_BALLS, "--threads", 1, "--seconds", 0.05, "--fps", 100,
+                "--gltf", tmp_path / "cli.glb", "--gltf-channels", "m_norm,speed")
+    py = magsim.run(scene, tmp_path / "py", seconds=0.05, fps=100, render=False,
+                    gltf=tmp_path / "py.glb", gltf_channels="m_norm,speed")
+    assert py["gltf"]["bytes"] == (tmp_path / "py.glb").stat().st_size
+    assert (tmp_path / "py.glb").read_bytes() == (tmp_path / "cli.glb").read_bytes()
+    with pytest.raises(ValueError, match=r"\.glb"):
+        magsim.run(scene, tmp_path / "bad", seconds=0.01, render=False, gltf=tmp_path / "x.gltf")
+    with pytest.raises(ValueError, match="needs --gltf"):
+        magsim.run(scene, tmp_path / "bad2", seconds=0.01, render=False, gltf_channels="speed")

@@ -217,7 +217,6 @@ int main(int argc, char** argv) {
       return kBadInput;
     }
   try {
-    if (app.count("--gltf") && !ends_with(a.gltf, ".glb")) throw UsageError("--gltf: the path must end in .glb, got '" + a.gltf + "'");
     if (app.count("--gltf-channels") && !app.count("--gltf")) throw UsageError("--gltf-channels needs --gltf");
     if (app.count("--gltf-channels")) parse_gltf_channels(a.gltf_channels);
     if (app.count("--write-scene")) return write_scene(a, app);

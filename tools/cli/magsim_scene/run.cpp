@@ -154,6 +154,7 @@ int run_scene(const engine::SceneDesc& scene, const RunPlan& a) {
                                       : std::min(kMaxSteps, std::max(1.0, secs / scene.options.dt));
     need.frames = std::min(need.steps, need.steps * a.fps * scene.options.dt) + 2;
     if (!a.gltf.empty()) {
+      if (!ends_with(a.gltf, ".glb")) throw UsageError("--gltf: the path must end in .glb, got '" + a.gltf + "'");
       // --gltf: refused up front when the file would pass glTF's 4 GiB; its frames are held
       // in memory until the end (a frame every max(1, round(1/(fps dt))) steps, first and last)
       const double every = std::max(1.0, std::round(1.0 / (a.fps * scene.options.dt)));

@@ -25,12 +25,14 @@ __all__ = ["Scene", "Simulation", "State", "SceneError", "SimulationError", "sce
 
 
 def run(scene, out_dir, seconds=None, steps=None, fps=60.0, render=True, width=1280,
-        height=720, samples=1, arrows=False):
+        height=720, samples=1, arrows=False, gltf=None, gltf_channels=None):
     """Runs `scene` as magsim-scene does and writes the same files into out_dir: summary.json,
     states.csv, moments.csv and (render=True, when built with the renderer) frame_*.png.
 
     seconds or steps (neither: the scene's default_seconds), fps and the frame size as
-    magsim-scene's --seconds, --steps, --fps, --width, --height, --samples, --arrows.
+    magsim-scene's --seconds, --steps, --fps, --width, --height, --samples, --arrows; gltf
+    (a path ending in .glb) and gltf_channels ("m_norm,speed") as its --gltf and
+    --gltf-channels: the run as one binary glTF 2.0 file for Blender.
     Returns summary.json as a dict. ValueError for bad arguments (magsim-scene's exit 1),
     SimulationError when the run failed (summary.json holds the error and the last good
     state), OSError when a file could not be written; Ctrl-C ends the run after the step in
@@ -56,7 +58,9 @@ def run(scene, out_dir, seconds=None, steps=None, fps=60.0, render=True, width=1
     out = os.fspath(out_dir)
     if not out:
         raise ValueError("--out: needs a non-empty path")
+    if gltf_channels and not gltf:
+        raise ValueError("--gltf-channels needs --gltf")
     _magsim._run(scene, out, steps or 0, float(seconds or 0.0), float(fps), bool(render), width,
-                 height, samples, bool(arrows))
+                 height, samples, bool(arrows), os.fspath(gltf) if gltf else "", gltf_channels or "")
     with open(os.path.join(out, "summary.json")) as f:
         return json.load(f)
