@@ -74,6 +74,8 @@ std::vector<int> find_escaped(const Model& m, const State& s) {
 
 std::vector<int> escaped_bodies(const Model& m, const State& s) { return find_escaped(m, s); }
 
+std::vector<int> held_bodies(const Model& m, const State& s) { return reachable(m, s, true); }
+
 double rotational_energy(const Model& m, const State& s, int b) {
   // ½ ωᵀ (R I Rᵀ) ω = ½ ω_bᵀ I ω_b with ω_b = Rᵀ ω the body-frame angular velocity
   const Vec3 w_body = s.quat[b].toRotationMatrix().transpose() * s.angvel[b];
@@ -115,9 +117,7 @@ Metrics compute_metrics(const Model& m, const State& s, const StepProfile& last)
       if (!m.body_magnet[b]) r.magnet_radius = std::max(r.magnet_radius, (s.pos[b] - s.pos[mb]).norm());
   }
   r.attached = static_cast<int>(reachable(m, s, false).size());
-  const std::vector<int> held = reachable(m, s, true);
-  r.held = static_cast<int>(held.size());
-  for (int b : held) r.held_max_speed = std::max(r.held_max_speed, s.vel[b].norm());
+  r.held = static_cast<int>(reachable(m, s, true).size());
   r.escaped = static_cast<int>(find_escaped(m, s).size());
   return r;
 }

@@ -27,9 +27,6 @@ struct Metrics {
   /// a contact to the ground is neither counted nor walked through. Unlike `attached`, a
   /// ball lying on the floor against a chain of balls is not held.
   int held = 0;
-  /// max |v| over the bodies `held` counts (m/s): the lifted pile's motion, without the
-  /// balls that slide on the floor (0 when none is held)
-  double held_max_speed = 0.0;
   /// dynamic bodies (magnets excluded) whose centre is farther than Model::escape_radius
   /// from the centroid of the magnet bodies (the magnet itself when there is one): the
   /// horizontal (x, y) distance when the scene has gravity (balls that fell off spread over
@@ -43,6 +40,10 @@ struct Metrics {
 };
 
 Metrics compute_metrics(const Model& model, const State& s, const StepProfile& last);
+
+/// The bodies Metrics::held counts (the lifted pile, without the bodies on the floor), in
+/// the order the contact graph reaches them.
+std::vector<int> held_bodies(const Model& model, const State& s);
 
 /// The bodies Metrics::escaped counts, ascending (empty when escape_radius is 0).
 std::vector<int> escaped_bodies(const Model& model, const State& s);

@@ -11,30 +11,35 @@ using namespace magsim;
 using mag::Method;
 using test::run_scene;
 
-TEST_CASE("balls_up: the default lifts the pile onto the magnet and holds it, the paper's 2 cm cube does not",
+TEST_CASE("balls_up: the default lifts the pile onto the magnet and holds it at rest, the paper's 2 cm cube does not",
           "[stability][balls_up]") {
-  // 243 balls, 2 s, trailing window 0.5 s, the scene's 3 cm N52 cube (29.7 A·m²). Kim 2018
-  // (the classic force too, its own magnetization) holds as many (measured 157, fastest ball
-  // within 0.15 m in the window 0.90 m/s against the default's 1.03: balls sliding on the
-  // frictionless ground), so it is stated, not asserted. The contrast is the magnet eq. 4
-  // was sized with, the paper's 2 cm cube (8.8 A·m², strength 0.296): under the classic
-  // force it lifts almost nothing.
+  // 243 balls, 2 s, trailing window 0.5 s, the scene's 3 cm N52 cube (29.7 A·m²) and iron's
+  // eddy loss. The marks read the lifted pile, the bodies the engine counts as held (the
+  // paper's "stably stuck to each other and to the magnet"): balls knocked onto the
+  // frictionless floor keep their speed, as they should, and are reported, not asserted.
+  // Ensemble: tools/findings/energy.md, "balls_up's marks on the lifted pile" (8 runs,
+  // 243…236 balls: held 142–155, the pile's fastest 0.028–0.101 m/s; 0.101 is this run of
+  // 243, a ball rocking on the skirt). The contrast is the magnet eq. 4 was sized with, the
+  // paper's 2 cm cube (8.8 A·m², strength 0.296): under the classic force it lifts almost
+  // nothing.
   const auto def = run_scene("balls_up", Method::Anderson, 2.0, 0.5);
-  INFO("default: held " << def.last.held << ", escaped " << def.last.escaped
-                        << ", fastest not escaped " << def.tail_max_speed_inside << " m/s");
+  const int on_floor = def.last.dynamic_bodies - def.last.held;
+  INFO("default: held " << def.last.held << ", its fastest in the last 0.5 s " << def.tail_max_speed_held
+                        << " m/s; not held " << on_floor << ", fastest body " << def.tail_max_speed << " m/s");
   REQUIRE_FALSE(def.failed);
-  CHECK(def.last.held >= 120);  // measured 158
-  CHECK(def.last.escaped <= 3);  // measured 0
+  CHECK(def.last.held >= 131);
+  CHECK(def.tail_max_speed_held <= 0.2);  // m/s: twice the ensemble's worst
   const auto small = run_scene("balls_up", Method::Anderson, 2.0, 0.5, 0, 8.8 / 29.7);
   INFO("2 cm cube: held " << small.last.held);
   REQUIRE_FALSE(small.failed);
-  CHECK(small.last.held <= 10);  // measured 0
+  CHECK(small.last.held <= 10);
 }
 
 TEST_CASE("balls_up at 3x strength with 20 QuickStep iterations keeps its pile: robustness corners",
           "[stability][balls_up][robustness]") {
   // corners of tools/scripts/robustness.sh (1 s, ×3, 20 QuickStep iterations instead of the
-  // scene's 100)
+  // scene's 100). Ensemble: tools/findings/energy.md, "the default suite's scene tests on
+  // ensembles" (4 runs a corner, 243…240: peak 3.4–8.2 m/s, 0–1 escaped)
   struct Corner {
     double w, dt;
   };
@@ -49,7 +54,7 @@ TEST_CASE("balls_up at 3x strength with 20 QuickStep iterations keeps its pile: 
               << r.last.escaped << ", KE " << r.last.kinetic_energy << " J");
     REQUIRE_FALSE(r.failed);
     CHECK(r.max_speed < 20.0);  // m/s: the matrix's bound
-    CHECK(r.last.escaped <= 3);  // measured 0 at each corner
+    CHECK(r.last.escaped <= 3);
   }
 }
 
@@ -102,37 +107,42 @@ TEST_CASE("falling_magnet at 3x strength with 40 QuickStep iterations: the defau
 
 TEST_CASE("sakura_tree: balls land on the branch-end magnets and stay without being flung",
           "[stability][sakura_tree]") {
-  // 500 balls (23 × 23 sheet over the tree), 0.8 s: they reach the tips at ≈ 0.16 s
+  // 500 balls (23 × 23 sheet over the tree), 0.8 s: they reach the tips at ≈ 0.16 s.
+  // Ensemble: tools/findings/energy.md, "the default suite's scene tests on ensembles"
+  // (4 runs, 500…497: peak 5.9 m/s, held 234–235, escaped 7–9)
   const auto r = run_scene("sakura_tree", Method::Anderson, 0.8, 0.1, 500);
   INFO("max speed " << r.max_speed << " m/s, held " << r.last.held << ", escaped " << r.last.escaped
                     << ", in the last 0.1 s " << r.tail_max_speed << " m/s");
   REQUIRE_FALSE(r.failed);
   CHECK(r.max_speed < 20.0);
-  CHECK(r.last.held >= 180);   // measured 225
-  CHECK(r.last.escaped <= 15);  // measured 5 (2500 balls, 2 s: 2–5)
+  CHECK(r.last.held >= 180);
+  CHECK(r.last.escaped <= 15);
 }
 
-TEST_CASE("alphabets at 300 A m^2: the default gathers the letters and they come to rest, Kim 2018's dynamics caps",
+TEST_CASE("alphabets at 300 A m^2: the default gathers every letter and loses energy, Kim 2018's dynamics caps",
           "[stability][alphabets]") {
   // The bottom layer of the grid (25 letters, 9 cm below the 300 A·m² centre), 1.2 s: they
   // reach the collider at ≈ 0.2 s. |H| ≥ 2.5 Ms at the letters, where the paper's Fig. 9 has
-  // Kim 2018's dynamics fail: its magnetization hits the iteration cap (it also gathers all 25;
-  // the fastest letter over the last 0.5 s is 3.6 m/s for it and 6.7 m/s for the default,
-  // both from the settling; stated, not asserted).
+  // Kim 2018's dynamics fail: its magnetization hits the iteration cap. Whether the last
+  // letter has stopped by 1.2 s is chaos (0.015–2.5 m/s at the end over the ensemble), so it
+  // is stated, not asserted; every run gathers all its letters and E only falls.
+  // Ensemble: tools/findings/energy.md, "the default suite's scene tests on ensembles"
+  // (6 runs, 25…20 letters).
   const auto r = run_scene("alphabets", Method::Anderson, 1.2, 0.5, 25);
   INFO("held " << r.last.held << ", escaped " << r.last.escaped << ", fastest " << r.max_speed
-               << " m/s, in the window " << r.tail_max_speed << " m/s, at the end "
-               << r.last.max_speed << " m/s, cap " << r.cap_fraction);
+               << " m/s, at the end " << r.last.max_speed << " m/s, cap " << r.cap_fraction << ", E rose "
+               << r.energy_rise << " J of " << r.energy_lost << " J lost");
   REQUIRE_FALSE(r.failed);
   CHECK(r.last.escaped == 0);
-  CHECK(r.last.held >= 24);           // measured 25
+  CHECK(r.last.held >= 24);
   CHECK(r.cap_fraction == 0.0);
-  CHECK(r.last.max_speed < 0.5);      // m/s; measured 0.09
+  CHECK(r.energy_lost > 20.0);                      // J
+  CHECK(r.energy_rise <= 0.01 * r.energy_lost);
   const auto kim = run_scene("alphabets", Method::Kim2018, 1.2, 0.5, 25);
   INFO("kim2018: held " << kim.last.held << ", in the window " << kim.tail_max_speed << " m/s, cap "
                         << kim.cap_fraction);
   REQUIRE_FALSE(kim.failed);
-  CHECK(kim.cap_fraction > 0.3);      // measured 0.45
+  CHECK(kim.cap_fraction > 0.3);
 }
 
 TEST_CASE("determinism: two runs of a scene give the same state hash", "[stability]") {

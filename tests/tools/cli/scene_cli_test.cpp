@@ -44,6 +44,7 @@ TEST_CASE("magsim-scene: --space, --quickstep-iterations and --auto-disable reac
   CHECK(j["final"]["held"].is_number_integer());
   CHECK(j["final"]["escaped"] == 0);  // 3 ms: nothing has left the pile
   CHECK(j["series"]["held"].size() == j["series"]["attached"].size());
+  CHECK(j["series"]["held_max_speed"].size() == j["series"]["held"].size());
   CHECK(j["series"]["escaped"].size() == j["series"]["time"].size());
   // the deepest contact overlap: over every step, so at least that of any recorded frame
   REQUIRE(j["series"]["contact_depth"].size() == j["series"]["time"].size());

@@ -126,6 +126,7 @@ class Recorder {
     series_["magnet_radius"].push_back(x.magnet_radius);
     series_["attached"].push_back(x.attached);
     series_["held"].push_back(x.held);
+    series_["held_max_speed"].push_back(held_speed(t));
     series_["escaped"].push_back(x.escaped);
     series_["iterations"].push_back(x.iterations);
     series_["momentum_norm"].push_back(x.momentum.norm());
@@ -157,6 +158,22 @@ class Recorder {
   const json& series() const { return series_; }
 
  private:
+  // The fastest held body (engine::held_bodies) as a viewer of the frames sees it: its
+  // displacement since the previous frame over the frame time (m/s); null at the first frame.
+  json held_speed(double t) {
+    const engine::State& s = sim_.state();
+    json v = nullptr;
+    if (!prev_pos_.empty() && t > prev_t_) {
+      double fastest = 0.0;
+      for (int b : engine::held_bodies(sim_.model(), s))
+        fastest = std::max(fastest, (s.pos[b] - prev_pos_[b]).norm() / (t - prev_t_));
+      v = fastest;
+    }
+    prev_pos_ = s.pos;
+    prev_t_ = t;
+    return v;
+  }
+
   // a failed write (full disk …) sets the stream's error flag; stop at the first
   void check() const {
     if (std::ferror(states_)) throw IoError("writing " + states_path_ + " failed (" + errno_text() + ")");
@@ -170,6 +187,8 @@ class Recorder {
   long last_step_ = -1;
   int frames_ = 0;
   json series_ = json::object();
+  std::vector<engine::Vec3> prev_pos_;  // the previous frame's centres (held_speed)
+  double prev_t_ = 0.0;
 };
 
 
