@@ -14,95 +14,99 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 namespace magsim::mag::detail::simd {
 
-// ---- portable lanes ---------------------------------------------------------------------
+// ---- portable lanes ----------------------------------------------------------------------
+//
+// GCC's generic vectors of 8 doubles or 16 floats: the compiler splits each operation into
+// the CPU's own width (2 × AVX2, 4 × SSE2), element-wise, so the lanes round as the AVX-512
+// registers do. A masked result is computed in every lane and then selected.
 
-/// W lanes of T; masks are bit sets (lane k ↔ bit k)
-template <class T, int W>
-struct Lanes {
-  T v[W];
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // 64-byte vectors by value: all of this inlines
+
+typedef double VecD8 __attribute__((vector_size(64)));
+typedef float VecF16 __attribute__((vector_size(64)));
+typedef float VecF8 __attribute__((vector_size(32)));
+typedef std::int64_t VecI64x8 __attribute__((vector_size(64)));
+typedef std::int32_t VecI32x16 __attribute__((vector_size(64)));
+
+/// 8 double lanes, 16 float lanes
+struct PD {
+  VecD8 v;
 };
-using PD = Lanes<double, 8>;
-using PF = Lanes<float, 16>;
-using PMask = std::uint32_t;
+struct PF {
+  VecF16 v;
+};
+/// lane masks: all ones (true) or zero per lane
+struct MD {
+  VecI64x8 m;
+};
+struct MF {
+  VecI32x16 m;
+};
+inline MD operator&(MD a, MD b) { return MD{a.m & b.m}; }
+inline MF operator&(MF a, MF b) { return MF{a.m & b.m}; }
+inline bool any(MD a) {
+  std::int64_t r = 0;
+  for (int k = 0; k < 8; ++k) r |= a.m[k];
+  return r != 0;
+}
+inline bool any(MF a) {
+  std::int32_t r = 0;
+  for (int k = 0; k < 16; ++k) r |= a.m[k];
+  return r != 0;
+}
 
-#define MAGSIM_LANES template <class T, int W> inline
-MAGSIM_LANES Lanes<T, W> ld_lanes(const T* p) {
-  Lanes<T, W> r;
-  for (int k = 0; k < W; ++k) r.v[k] = p[k];
+/// loads the lanes from p; the second argument (its value unused) picks the lane set
+inline PD ld(const double* p, PD) {
+  PD r;
+  std::memcpy(&r.v, p, sizeof r.v);
   return r;
 }
-/// loads W lanes from p; the second argument (its value unused) picks the lane set
-inline PD ld(const double* p, PD) { return ld_lanes<double, 8>(p); }
-inline PF ld(const float* p, PF) { return ld_lanes<float, 16>(p); }
-MAGSIM_LANES Lanes<T, W> add(Lanes<T, W> a, Lanes<T, W> b) {
-  for (int k = 0; k < W; ++k) a.v[k] = a.v[k] + b.v[k];
-  return a;
-}
-MAGSIM_LANES Lanes<T, W> sub(Lanes<T, W> a, Lanes<T, W> b) {
-  for (int k = 0; k < W; ++k) a.v[k] = a.v[k] - b.v[k];
-  return a;
-}
-MAGSIM_LANES Lanes<T, W> mul(Lanes<T, W> a, Lanes<T, W> b) {
-  for (int k = 0; k < W; ++k) a.v[k] = a.v[k] * b.v[k];
-  return a;
-}
-/// max(a, b) as the x86 instruction has it: b where either is NaN or both are zeros
-MAGSIM_LANES Lanes<T, W> max(Lanes<T, W> a, Lanes<T, W> b) {
-  for (int k = 0; k < W; ++k) a.v[k] = a.v[k] > b.v[k] ? a.v[k] : b.v[k];
-  return a;
-}
-/// a in the lanes of m, 0 elsewhere
-MAGSIM_LANES Lanes<T, W> keep(PMask m, Lanes<T, W> a) {
-  for (int k = 0; k < W; ++k) a.v[k] = (m >> k) & 1u ? a.v[k] : T(0);
-  return a;
-}
-/// lanes where a < b (false for NaN)
-MAGSIM_LANES PMask less(Lanes<T, W> a, Lanes<T, W> b) {
-  PMask m = 0;
-  for (int k = 0; k < W; ++k) m |= static_cast<PMask>(a.v[k] < b.v[k]) << k;
-  return m;
-}
-/// √a in the lanes of m, 0 elsewhere
-MAGSIM_LANES Lanes<T, W> sqrt(PMask m, Lanes<T, W> a) {
-  for (int k = 0; k < W; ++k) a.v[k] = (m >> k) & 1u ? std::sqrt(a.v[k]) : T(0);
-  return a;
-}
-/// a/b in the lanes of m, 0 elsewhere
-MAGSIM_LANES Lanes<T, W> div(PMask m, Lanes<T, W> a, Lanes<T, W> b) {
-  for (int k = 0; k < W; ++k) a.v[k] = (m >> k) & 1u ? a.v[k] / b.v[k] : T(0);
-  return a;
-}
-/// a·b in the lanes of m, a elsewhere
-MAGSIM_LANES Lanes<T, W> mul_in(PMask m, Lanes<T, W> a, Lanes<T, W> b) {
-  for (int k = 0; k < W; ++k) a.v[k] = (m >> k) & 1u ? a.v[k] * b.v[k] : a.v[k];
-  return a;
-}
-MAGSIM_LANES Lanes<T, W> splat(Lanes<T, W>, double x) {
-  Lanes<T, W> r;
-  for (int k = 0; k < W; ++k) r.v[k] = static_cast<T>(x);
+inline PF ld(const float* p, PF) {
+  PF r;
+  std::memcpy(&r.v, p, sizeof r.v);
   return r;
 }
-/// the first n lanes (n ≤ W)
-MAGSIM_LANES PMask first_lanes(Lanes<T, W>, std::size_t n) {
-  return static_cast<PMask>((1ull << n) - 1ull);
-}
-/// a·b + c, rounded twice (never fused: the same on every CPU)
-MAGSIM_LANES Lanes<T, W> mul_add(Lanes<T, W> a, Lanes<T, W> b, Lanes<T, W> c) {
-  return add(mul(a, b), c);
-}
-/// c − a·b, rounded twice
-MAGSIM_LANES Lanes<T, W> neg_mul_add(Lanes<T, W> a, Lanes<T, W> b, Lanes<T, W> c) {
-  return sub(c, mul(a, b));
-}
-/// a·x + b·y + c·z, left to right
-MAGSIM_LANES Lanes<T, W> dot3(Lanes<T, W> a, Lanes<T, W> b, Lanes<T, W> c, Lanes<T, W> x,
-                              Lanes<T, W> y, Lanes<T, W> z) {
-  return add(add(mul(a, x), mul(b, y)), mul(c, z));
-}
-#undef MAGSIM_LANES
+
+#define MAGSIM_PORTABLE_OPS(P, M, T, N)                                                      \
+  inline P add(P a, P b) { return P{a.v + b.v}; }                                            \
+  inline P sub(P a, P b) { return P{a.v - b.v}; }                                            \
+  inline P mul(P a, P b) { return P{a.v * b.v}; }                                            \
+  /* max as the x86 instruction has it: b where either is NaN or both are zeros */            \
+  inline P max(P a, P b) { return P{a.v > b.v ? a.v : b.v}; }                                \
+  inline P keep(M m, P a) {                                                                  \
+    const P zero{};                                                                          \
+    return P{m.m != 0 ? a.v : zero.v};                                                       \
+  }                                                                                          \
+  inline M less(P a, P b) { return M{a.v < b.v}; }                                           \
+  inline P sqrt(M m, P a) {                                                                  \
+    P r;                                                                                     \
+    for (int k = 0; k < N; ++k) r.v[k] = std::sqrt(a.v[k]);                                  \
+    return keep(m, r);                                                                       \
+  }                                                                                          \
+  inline P div(M m, P a, P b) { return keep(m, P{a.v / b.v}); }                              \
+  inline P mul_in(M m, P a, P b) { return P{m.m != 0 ? a.v * b.v : a.v}; }                   \
+  inline P splat(P, double x) {                                                              \
+    P r;                                                                                     \
+    for (int k = 0; k < N; ++k) r.v[k] = static_cast<T>(x);                                  \
+    return r;                                                                                \
+  }                                                                                          \
+  inline M first_lanes(P, std::size_t n) {                                                   \
+    M r;                                                                                     \
+    for (int k = 0; k < N; ++k) r.m[k] = static_cast<std::size_t>(k) < n ? -1 : 0;           \
+    return r;                                                                                \
+  }                                                                                          \
+  /* a·b + c and c − a·b, rounded twice (never fused); a·x + b·y + c·z left to right */      \
+  inline P mul_add(P a, P b, P c) { return add(mul(a, b), c); }                              \
+  inline P neg_mul_add(P a, P b, P c) { return sub(c, mul(a, b)); }                          \
+  inline P dot3(P a, P b, P c, P x, P y, P z) { return add(add(mul(a, x), mul(b, y)), mul(c, z)); }
+MAGSIM_PORTABLE_OPS(PD, MD, double, 8)
+MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
+#undef MAGSIM_PORTABLE_OPS
 
 /// A constant in every lane of V (cst<PD>(x), cst<V8>(x), …)
 template <class V>
@@ -111,47 +115,48 @@ inline V cst(double x) {
 }
 
 /// 1/√q in the lanes of m, 0 elsewhere; see inv_sqrt for __m512d
-inline PD inv_sqrt(PMask m, PD q) {
-  PD y;
-  for (int k = 0; k < 8; ++k) {
-    const float qf = static_cast<float>(q.v[k]);
-    double r = static_cast<double>(1.0f / std::sqrt(qf));
-    const double h = 0.5 * q.v[k];
-    for (int it = 0; it < 2; ++it) r = r * (1.5 - h * (r * r));
-    y.v[k] = (m >> k) & 1u ? r : 0.0;
-  }
-  return y;
+inline PD inv_sqrt(MD m, PD q) {
+  VecF8 f = __builtin_convertvector(q.v, VecF8);
+  VecF8 s;
+  for (int k = 0; k < 8; ++k) s[k] = std::sqrt(f[k]);
+  f = 1.0f / s;
+  PD y{__builtin_convertvector(f, VecD8)};
+  const VecD8 h = 0.5 * q.v;
+  for (int it = 0; it < 2; ++it) y.v = y.v * (1.5 - h * (y.v * y.v));
+  return keep(m, y);
 }
-inline PF inv_sqrt(PMask m, PF q) {
-  for (int k = 0; k < 16; ++k) q.v[k] = (m >> k) & 1u ? 1.0f / std::sqrt(q.v[k]) : 0.0f;
-  return q;
+inline PF inv_sqrt(MF m, PF q) {
+  PF s;
+  for (int k = 0; k < 16; ++k) s.v[k] = std::sqrt(q.v[k]);
+  return keep(m, PF{1.0f / s.v});
 }
 
 /// Lanes whose ids differ from `self` (ids as doubles, NaN never equal; or as int32)
-inline PMask differ_lanes(const double* ids, double self, PD) {
-  PMask m = 0;
-  for (int k = 0; k < 8; ++k) m |= static_cast<PMask>(!(ids[k] == self)) << k;
-  return m;
+inline MD differ_lanes(const double* ids, double self, PD) {
+  const PD i = ld(ids, PD{});
+  return MD{i.v != self};
 }
-inline PMask differ_lanes(const std::int32_t* ids, std::int32_t self, PF) {
-  PMask m = 0;
-  for (int k = 0; k < 16; ++k) m |= static_cast<PMask>(ids[k] != self) << k;
-  return m;
+inline MF differ_lanes(const std::int32_t* ids, std::int32_t self, PF) {
+  VecI32x16 i;
+  std::memcpy(&i, ids, sizeof i);
+  return MF{i != self};
 }
 
 /// acc + v lane by lane (double); 16 float lanes: lane k of acc gets float lanes k and k + 8,
 /// widened exactly, as acc_k + (v_k + v_{k+8})
 inline PD fold(PD acc, PD v) { return add(acc, v); }
 inline PD fold(PD acc, PF v) {
-  for (int k = 0; k < 8; ++k)
-    acc.v[k] = acc.v[k] + (static_cast<double>(v.v[k]) + static_cast<double>(v.v[k + 8]));
-  return acc;
+  VecF8 lo, hi;
+  std::memcpy(&lo, &v.v, sizeof lo);
+  std::memcpy(&hi, reinterpret_cast<const char*>(&v.v) + sizeof lo, sizeof hi);
+  return PD{acc.v + (__builtin_convertvector(lo, VecD8) + __builtin_convertvector(hi, VecD8))};
 }
 /// the eight lanes summed in one fixed tree
 inline double hsum(PD v) {
-  const double* t = v.v;
-  return ((t[0] + t[4]) + (t[1] + t[5])) + ((t[2] + t[6]) + (t[3] + t[7]));
+  return ((v.v[0] + v.v[4]) + (v.v[1] + v.v[5])) + ((v.v[2] + v.v[6]) + (v.v[3] + v.v[7]));
 }
+
+#pragma GCC diagnostic pop
 
 }  // namespace magsim::mag::detail::simd
 
@@ -191,6 +196,8 @@ inline V8 mul_in(__mmask8 k, V8 a, V8 b) { return _mm512_mask_mul_pd(a, k, a, b)
 inline V16 mul_in(__mmask16 k, V16 a, V16 b) { return _mm512_mask_mul_ps(a, k, a, b); }
 inline V8 splat(V8, double x) { return _mm512_set1_pd(x); }
 inline V16 splat(V16, double x) { return _mm512_set1_ps(static_cast<float>(x)); }
+inline bool any(__mmask8 m) { return m != 0; }
+inline bool any(__mmask16 m) { return m != 0; }
 inline __mmask8 first_lanes(V8, std::size_t n) { return static_cast<__mmask8>((1u << n) - 1u); }
 inline __mmask16 first_lanes(V16, std::size_t n) { return static_cast<__mmask16>((1u << n) - 1u); }
 // clang-format on
