@@ -66,15 +66,7 @@ std::size_t chunk_blocks(std::size_t nb, std::size_t per_sum) {
 // The series over portable lanes (any CPU) …
 namespace portable {
 template <class T>
-struct LaneOf;
-template <>
-struct LaneOf<double> {
-  using V = detail::simd::PD;
-};
-template <>
-struct LaneOf<float> {
-  using V = detail::simd::PF;
-};
+using LaneOf = detail::simd::PortableLaneOf<T>;
 #include "magnetics/far_block.inc"
 }  // namespace portable
 
@@ -84,15 +76,7 @@ struct LaneOf<float> {
 #pragma GCC target("avx512f")
 namespace avx512 {
 template <class T>
-struct LaneOf;
-template <>
-struct LaneOf<double> {
-  using V = detail::simd::V8;
-};
-template <>
-struct LaneOf<float> {
-  using V = detail::simd::V16;
-};
+using LaneOf = detail::simd::Avx512LaneOf<T>;
 #include "magnetics/far_block.inc"
 }  // namespace avx512
 #pragma GCC pop_options

@@ -65,15 +65,7 @@ void finish(const double* acc, bool jac, double* Hout, double* Jout) {
 // The sweep over portable lanes (any CPU) …
 namespace portable {
 template <class T>
-struct LaneOf;
-template <>
-struct LaneOf<double> {
-  using V = simd::PD;
-};
-template <>
-struct LaneOf<float> {
-  using V = simd::PF;
-};
+using LaneOf = simd::PortableLaneOf<T>;
 #include "magnetics/pair_sweep.inc"
 }  // namespace portable
 
@@ -83,15 +75,7 @@ struct LaneOf<float> {
 #pragma GCC target("avx512f")
 namespace avx512 {
 template <class T>
-struct LaneOf;
-template <>
-struct LaneOf<double> {
-  using V = simd::V8;
-};
-template <>
-struct LaneOf<float> {
-  using V = simd::V16;
-};
+using LaneOf = simd::Avx512LaneOf<T>;
 #include "magnetics/pair_sweep.inc"
 }  // namespace avx512
 #pragma GCC pop_options

@@ -108,6 +108,18 @@ MAGSIM_PORTABLE_OPS(PD, MD, double, 8)
 MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 #undef MAGSIM_PORTABLE_OPS
 
+/// The portable lane set of a scalar type (a kernel body reads LaneOf<T>::V)
+template <class T>
+struct PortableLaneOf;
+template <>
+struct PortableLaneOf<double> {
+  using V = PD;
+};
+template <>
+struct PortableLaneOf<float> {
+  using V = PF;
+};
+
 /// A constant in every lane of V (cst<PD>(x), cst<V8>(x), …)
 template <class V>
 inline V cst(double x) {
@@ -196,6 +208,18 @@ inline V8 mul_in(__mmask8 k, V8 a, V8 b) { return _mm512_mask_mul_pd(a, k, a, b)
 inline V16 mul_in(__mmask16 k, V16 a, V16 b) { return _mm512_mask_mul_ps(a, k, a, b); }
 inline V8 splat(V8, double x) { return _mm512_set1_pd(x); }
 inline V16 splat(V16, double x) { return _mm512_set1_ps(static_cast<float>(x)); }
+/// The AVX-512 lane set of a scalar type
+template <class T>
+struct Avx512LaneOf;
+template <>
+struct Avx512LaneOf<double> {
+  using V = V8;
+};
+template <>
+struct Avx512LaneOf<float> {
+  using V = V16;
+};
+
 inline bool any(__mmask8 m) { return m != 0; }
 inline bool any(__mmask16 m) { return m != 0; }
 inline __mmask8 first_lanes(V8, std::size_t n) { return static_cast<__mmask8>((1u << n) - 1u); }
