@@ -62,33 +62,38 @@ TEST_CASE("falling_magnet without magnetism comes to rest: rolling resistance on
           "[stability][falling_magnet][long]") {
   // The mechanical control: the 12×12×8 block collapses under the falling magnet (strength
   // 0.001: no magnetic force to speak of). Without rolling resistance the balls roll on for
-  // ever (final KE 0.126 J, 17 beyond 1 m at 2 s).
+  // ever (final KE 0.126 J, 17 beyond 1 m at 2 s). Ensemble: tools/findings/energy.md, "the
+  // long tests on ensembles" (1032…1029: fastest in the last second 0.006–0.094 m/s, final
+  // KE 7e-8–8e-7 J, none escaped).
   const auto r = run_scene("falling_magnet", Method::Anderson, 2.0, 1.0, 0, 0.001);
   INFO("last second: fastest " << r.tail_max_speed << " m/s; KE " << r.last.kinetic_energy
                                << " J; escaped " << r.last.escaped);
   REQUIRE_FALSE(r.failed);
-  CHECK(r.tail_max_speed < 0.1);        // m/s
+  CHECK(r.tail_max_speed < 0.2);        // m/s: twice the ensemble's worst
   CHECK(r.last.kinetic_energy < 1e-4);  // J
   CHECK(r.last.escaped == 0);           // none beyond 1 m (17 without resistance)
 }
 
 TEST_CASE("falling_magnet: the magnet lands in the heap and holds it, nothing is thrown far",
           "[stability][falling_magnet][long]") {
-  // 1032 balls, 1.2 s, the scene's defaults; window the last 0.2 s
+  // 1032 balls, 1.2 s, the scene's defaults; window the last 0.2 s. Ensemble: "the long
+  // tests on ensembles" (1032…1029: held 616–638, none escaped, fastest 0.13–0.50 m/s)
   const auto r = run_scene("falling_magnet", Method::Anderson, 1.2, 0.2);
   INFO("held " << r.last.held << ", attached " << r.last.attached << ", escaped "
                << r.last.escaped << ", fastest " << r.max_speed << " m/s, in the last 0.2 s "
                << r.tail_max_speed << " m/s");
   REQUIRE_FALSE(r.failed);
-  CHECK(r.last.held >= 550);  // measured 634
+  CHECK(r.last.held >= 550);
   CHECK(r.last.escaped == 0);
-  CHECK(r.tail_max_speed < 1.0);  // m/s; measured 0.51
+  CHECK(r.tail_max_speed < 1.0);  // m/s
 }
 
 TEST_CASE("falling_magnet at 3x strength with 40 QuickStep iterations: the default throws nothing, eq. 4 runs away",
           "[stability][falling_magnet][long]") {
   // 600 balls, 0.6 s. eq. 4's surplus work, with its reaction-symmetric forces' net torque,
-  // spun and rolled the magnet and its heap across the floor at this corner.
+  // spun and rolled the magnet and its heap across the floor at this corner. Ensemble of the
+  // default: "the long tests on ensembles" (600…597: KE in the last 0.1 s 0.0046–0.0104 J,
+  // none escaped)
   auto run = [](Method m) {
     return run_scene("falling_magnet", m, 0.6, 0.1, 600, 3.0, 0.0,
                      [](engine::SceneDesc& d) { d.options.quickstep_iterations = 40; });
@@ -97,7 +102,7 @@ TEST_CASE("falling_magnet at 3x strength with 40 QuickStep iterations: the defau
   INFO("default: KE in the last 0.1 s " << def.tail_max_ke << " J, escaped " << def.last.escaped << ", fastest "
                                         << def.max_speed << " m/s");
   REQUIRE_FALSE(def.failed);
-  CHECK(def.tail_max_ke < 0.1);  // J; measured 0.0077
+  CHECK(def.tail_max_ke < 0.1);  // J
   CHECK(def.last.escaped == 0);
   const auto eq4 = run(Method::OursRealigned);
   INFO("eq. 4: KE in the last 0.1 s " << eq4.tail_max_ke << " J, escaped " << eq4.last.escaped
