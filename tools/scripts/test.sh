@@ -6,7 +6,8 @@
 #   bash tools/scripts/test.sh --all      every test, the long end-to-end runs too (~40 min)
 #   bash tools/scripts/test.sh --asan     ASan+UBSan build in build/asan (renderer off), portable
 #   bash tools/scripts/test.sh --portable Release build in build/portable, portable
-#   bash tools/scripts/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability)
+#   bash tools/scripts/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability); a -L,
+#                                         -LE, -R or -E of yours replaces the default -LE long
 # Portable: -DMAGSIM_NATIVE=OFF, baseline x86-64 and the portable field kernels. Every build
 # gives the same golden state hashes on every x86-64 CPU (tests/engine/golden_hashes.txt).
 # Installs the Debian packages first if any is missing (tools/scripts/setup.sh --deps-only).
@@ -21,7 +22,10 @@ while [ $# -gt 0 ]; do
     --asan) preset=asan ;;
     --portable) preset=portable ;;
     --all) select=() ;;
-    --) shift; ctest_args=("$@"); break ;;
+    --) shift; ctest_args=("$@")
+        # a label or name selection of the caller's own replaces the default one
+        for x in "$@"; do case "$x" in -L|-LE|-R|-E|--label-regex|--label-exclude) select=() ;; esac; done
+        break ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "test.sh: unknown option '$1' (try --help)" >&2; exit 2 ;;
   esac
