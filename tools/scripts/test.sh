@@ -3,7 +3,7 @@
 #
 #   bash tools/scripts/test.sh            Release build in build/release, the default suite:
 #                                         every test but those labelled long (≤ 8 min, 2 cores)
-#   bash tools/scripts/test.sh --all      every test, the long end-to-end runs too (~40 min)
+#   bash tools/scripts/test.sh --all      every test, the long end-to-end runs too (~5 min more)
 #   bash tools/scripts/test.sh --asan     ASan+UBSan build in build/asan (renderer off), portable
 #   bash tools/scripts/test.sh --portable Release build in build/portable, portable
 #   bash tools/scripts/test.sh -- ARGS    extra arguments for ctest (e.g. -- -L stability); a -L,
