@@ -181,7 +181,8 @@ def check_scene(path, out, timeout):
         return f"exit 0 with an unreadable summary.json ({e})"
     if s.get("error") is not None:
         return "exit 0 with an error in summary.json"
-    if not finite_json({k: v for k, v in s.items() if k not in ("error", "signal")}):  # null: none
+    # null: none (error, signal) or no --gltf file (gltf)
+    if not finite_json({k: v for k, v in s.items() if k not in ("error", "signal", "gltf")}):
         return "exit 0 with a non-finite value in summary.json"
     with open(os.path.join(out, "states.csv"), "rb") as f:
         data = f.read()

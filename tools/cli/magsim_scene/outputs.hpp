@@ -159,16 +159,14 @@ class Recorder {
 
  private:
   // The fastest held body (engine::held_bodies) as a viewer of the frames sees it: its
-  // displacement since the previous frame over the frame time (m/s); null at the first frame.
-  json held_speed(double t) {
+  // displacement since the previous frame over the frame time (m/s); 0 at the first frame,
+  // which has no displacement yet.
+  double held_speed(double t) {
     const engine::State& s = sim_.state();
-    json v = nullptr;
-    if (!prev_pos_.empty() && t > prev_t_) {
-      double fastest = 0.0;
+    double v = 0.0;
+    if (!prev_pos_.empty() && t > prev_t_)
       for (int b : engine::held_bodies(sim_.model(), s))
-        fastest = std::max(fastest, (s.pos[b] - prev_pos_[b]).norm() / (t - prev_t_));
-      v = fastest;
-    }
+        v = std::max(v, (s.pos[b] - prev_pos_[b]).norm() / (t - prev_t_));
     prev_pos_ = s.pos;
     prev_t_ = t;
     return v;
