@@ -1,6 +1,6 @@
 // magnetics/simd.hpp — internal: the lane operations of the field kernels, in two sets that
-// give the same bits: portable lanes (Lanes<T, W>, plain loops that any compiler vectorizes
-// at any width) and AVX-512 registers (__m512d, __m512). A kernel body is written once over
+// give the same bits: portable lanes (PD, PF: GCC generic vectors that the compiler splits into
+// the CPU's width) and AVX-512 registers (__m512d, __m512). A kernel body is written once over
 // these names (pair_sweep.inc, far_block.inc) and compiled for both sets, so its result does
 // not depend on the CPU. Every operation is element-wise IEEE (+, −, ×, ÷, √, max, compare,
 // select), FMA is never used ("mul_add" rounds twice), sums across lanes follow one tree

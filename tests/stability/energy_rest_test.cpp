@@ -38,8 +38,7 @@ HeapRun run_heap(const std::string& scene, int count, double strength, double se
   HeapRun r;
   const long n = static_cast<long>(seconds / d.options.dt + 0.5);
   const long from = n - static_cast<long>(tail / d.options.dt + 0.5);
-  const long e_from = static_cast<long>(0.05 / d.options.dt + 0.5);
-  double e_start = 0, low = 0;
+  test::EnergyWatch energy(d.options.dt);
   try {
     for (long k = 1; k <= n; ++k) {
       const double K0 = sim.energy().kinetic;
@@ -52,11 +51,7 @@ HeapRun run_heap(const std::string& scene, int count, double strength, double se
       const double tol = m.options.energy_guard_tolerance * (K0 + e.kinetic + std::abs(u_start)) +
                          m.options.energy_guard_floor;
       r.max_rise = std::max(r.max_rise, dE - tol);
-      if (k == e_from) e_start = low = E;
-      if (k >= e_from) {
-        low = std::min(low, E);
-        r.rise_above_min = std::max(r.rise_above_min, E - low);
-      }
+      energy.after_step(k, E);
       if (k >= from) {
         // the magnet: the dynamic magnet body; balls within 0.12 m of it
         for (int b : m.dynamic_bodies) {
@@ -72,7 +67,8 @@ HeapRun run_heap(const std::string& scene, int count, double strength, double se
     r.failed = true;
     r.error = e.what();
   }
-  r.energy_lost = e_start - engine::total_energy(sim.energy());
+  r.rise_above_min = energy.rise;
+  r.energy_lost = energy.lost;
   r.unresolved = sim.energy().guard_unresolved;
   r.retakes = sim.energy().guard_retakes;
   return r;

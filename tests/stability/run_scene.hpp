@@ -13,6 +13,21 @@
 
 namespace magsim::test {
 
+/// E = K + U_g + U* from 0.05 s on, step by step: the most it stood above its running minimum
+/// (rise) and E(0.05 s) − E(now) (lost), in J, as tools/scripts/ensemble.py reads them.
+struct EnergyWatch {
+  explicit EnergyWatch(double dt) : from(std::lround(0.05 / dt)) {}
+  void after_step(long k, double E) {
+    if (k == from) start = low = E;
+    if (k < from) return;
+    low = std::min(low, E);
+    rise = std::max(rise, E - low);
+    lost = start - E;
+  }
+  long from;
+  double start = 0, low = 0, rise = 0, lost = 0;
+};
+
 struct SceneRun {
   engine::Metrics last;
   double tail_max_speed = 0;     ///< max body speed over the trailing window (m/s)
@@ -71,18 +86,11 @@ inline SceneRun run_scene(const std::string& name, mag::Method method, double se
   long caps = 0;
   const long frame = std::max(1L, std::lround(0.05 / d.options.dt));  // 20 frames per second
   std::vector<engine::Vec3> prev;  // the centres at the previous 20 fps frame
-  const long e_from = std::lround(0.05 / d.options.dt);
-  double e_start = 0, e_low = 0;
+  EnergyWatch energy(d.options.dt);
   try {
     for (long k = 1; k <= n; ++k) {
       sim.step();
-      const double E = engine::total_energy(sim.energy());
-      if (k == e_from) e_start = e_low = E;
-      if (k >= e_from) {
-        e_low = std::min(e_low, E);
-        r.energy_rise = std::max(r.energy_rise, E - e_low);
-        r.energy_lost = e_start - E;
-      }
+      energy.after_step(k, engine::total_energy(sim.energy()));
       caps += sim.last_profile().cap_hit;
       if (k % frame == 0) {
         if (k >= tail_from && !prev.empty())
@@ -106,6 +114,8 @@ inline SceneRun run_scene(const std::string& name, mag::Method method, double se
     r.failed = true;
     r.error = e.what();
   }
+  r.energy_rise = energy.rise;
+  r.energy_lost = energy.lost;
   r.last = sim.metrics();
   r.cap_fraction = static_cast<double>(caps) / std::max(1L, sim.steps());
   r.hash = sim.state_hash();
