@@ -70,6 +70,10 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (o.balance_magnetic_torque && !o.reaction_symmetric_forces)
     fail("options.balance_magnetic_torque",
          "needs reaction_symmetric_forces (it removes the torque those forces leave)");
+  if (o.sleep && o.auto_disable)
+    fail("options.sleep", "and auto_disable both put bodies to sleep: choose one (sleep knows the magnetics)");
+  if (o.sleep && o.magnetics.method == mag::Method::Exact)
+    fail("options.sleep", "needs a relaxation method: exact re-solves every moment, a sleeping one too");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
   // the pair model is a correction of U*: only the classic force is its gradient

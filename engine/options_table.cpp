@@ -19,7 +19,7 @@ namespace magsim::engine {
 // update the size here (x86-64, GCC/Clang).
 static_assert(sizeof(mag::FieldOptions) == 64, "FieldOptions changed: declare the new member in options_table()");
 static_assert(sizeof(mag::DynamicsOptions) == 168, "DynamicsOptions changed: declare the new member in options_table()");
-static_assert(sizeof(SimOptions) == 408, "SimOptions changed: declare the new member in options_table()");
+static_assert(sizeof(SimOptions) == 432, "SimOptions changed: declare the new member in options_table()");
 
 std::string number_text(double x) {
   char b[40];
@@ -323,6 +323,21 @@ std::vector<OptionSpec> build() {
           .flag("--space"),
       boolean(MEMBER(auto_disable), "let ODE put resting bodies to sleep (woken when their magnetic load changes)")
           .switch_flag("--auto-disable"),
+      boolean(MEMBER(sleep),
+              "sleeping islands: bodies joined by contacts that have all been still (sleep_speed) for sleep_time "
+              "leave the rigid step, their moments stay field sources with M frozen; woken by a touch, by a "
+              "change of the field at a moment beyond sleep_field_tolerance, or by the user")
+          .flag("--sleep"),
+      number(MEMBER(sleep_speed), above(0), "m/s",
+             "a body is still while it stays within sleep_speed * sleep_time of the pose where it came to "
+             "rest (|dx| + r_body |dtheta|): its mean speed over the window")
+          .flag("--sleep-speed"),
+      number(MEMBER(sleep_time), above(0), "s", "how long every body of an island must be still before it sleeps")
+          .flag("--sleep-time"),
+      number(MEMBER(sleep_field_tolerance), above(0), "",
+             "a sleeping island wakes when the field at one of its moments moves by more than this fraction of "
+             "its value when the island fell asleep (at least this fraction of 0.01 Ms)")
+          .flag("--sleep-field-tolerance"),
       number(MEMBER(linear_damping), at_least(0), "1/s", "velocity decay rate c: v <- v e^(-c dt) per step"),
       number(MEMBER(angular_damping), at_least(0), "1/s", "the same for the angular velocity"),
       number(MEMBER(surface_layer), at_least(0), "m", "ODE contact surface layer: the resting penetration allowed"),

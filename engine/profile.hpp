@@ -31,6 +31,7 @@ struct StepProfile {
   int contacts = 0;  ///< contact joints created this step (its last sub-step)
   int substeps = 1;  ///< rigid sub-steps the frame was split into (SimOptions::max_substeps)
   int guard_retakes = 0;  ///< times the energy guard retook this frame (SimOptions::energy_guard)
+  int asleep = 0;  ///< bodies asleep at the end of the step (SimOptions::sleep)
 };
 
 /// Adds the wall time of its scope (ms) to *out. steady_clock, so immune to clock jumps.

@@ -174,6 +174,17 @@ struct SimOptions {
   /// (tests/engine/golden_hash_test.cpp checks sap, hash and simple)
   SpaceKind space = SpaceKind::SweepAndPrune;
   bool auto_disable = false;       ///< ODE auto-disable of resting bodies
+  /// Sleeping islands (engine/sleep.cpp): an island of dynamic bodies joined by contacts falls
+  /// asleep when every body has stayed for sleep_time within sleep_speed × sleep_time of the
+  /// pose where it came to rest (|Δx| + r_body |Δθ|: a mean speed, jitter in place allowed);
+  /// asleep, its bodies leave ODE's step and its moments stay field sources with their
+  /// magnetization frozen. It wakes when an awake body touches it, or when the field at one of
+  /// its moments has moved since it fell asleep by more than sleep_field_tolerance × |H| (at
+  /// least that fraction of 0.01 Ms).
+  bool sleep = false;
+  double sleep_speed = 0.02;            ///< m/s
+  double sleep_time = 0.1;              ///< s
+  double sleep_field_tolerance = 0.02;  ///< relative
   double linear_damping = 0.0;     ///< velocity decay rate c (1/s): v ← v·e^{−cΔt} per step; 0 = none
   double angular_damping = 0.0;    ///< the same for angular velocity (1/s)
   double surface_layer = 0.0;      ///< ODE contact surface layer: resting penetration allowed (m)

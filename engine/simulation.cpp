@@ -2,6 +2,8 @@
 // Simulation facade. The step itself is in step.cpp.
 #include "engine/simulation.hpp"
 
+#include "engine/sleep.hpp"
+
 #include "engine/ode_bridge.hpp"
 #include "engine/stages.hpp"
 
@@ -76,12 +78,18 @@ void Simulation::restore_state(const State& s) {
     throw std::invalid_argument(std::string("restore_state: ") + e.what());
   }
   state_ = s;
-  ws_.next = s;
+  prepare_sleep(*model_, &state_);  // a state saved without the sleep arrays starts awake
+  ws_.next = state_;
   // forget the wake-up reference of auto-disable: it is re-learnt on the next step
   std::fill(ws_.body_force_awake.begin(), ws_.body_force_awake.end(), Vec3::Zero());
   rollback();
   profile_ = StepProfile{};
   energy_ = start_energy_audit(*model_, state_);
+}
+
+void Simulation::wake_all() {
+  engine::wake_all(*model_, &state_);
+  rollback();
 }
 
 void Simulation::rollback() {

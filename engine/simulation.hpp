@@ -61,6 +61,10 @@ class Simulation {
 
   render::Frame frame(const FrameOptions& opt = {}) const;
 
+  /// Wakes every sleeping body (SimOptions::sleep), e.g. after the caller moved or edited one
+  /// through restore_state; their moments are solved free again from the next step on.
+  void wake_all();
+
   /// The moments' description at the poses of the last step (world positions, permanent
   /// moments); their magnetizations are state().mag.
   const mag::MomentDesc& moments() const { return moments_; }

@@ -1,6 +1,8 @@
 // engine/state.cpp — initial state, shape check and the FNV-1a state hash.
 #include "engine/state.hpp"
 
+#include "engine/sleep.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -16,6 +18,7 @@ State initial_state(const Model& m) {
   s.dvel.assign(m.nbody, Vec3::Zero());
   s.mag_accel.assign(m.nbody, 0.0);
   s.enabled.assign(m.nbody, 1);
+  prepare_sleep(m, &s);
   mag::Magnetization& mz = s.mag;
   mz.M1.assign(m.nmoment, Vec3::Zero());
   mz.M2.assign(m.nmoment, Vec3::Zero());
@@ -86,6 +89,20 @@ void check_state_shape(const Model& m, const State& s) {
                                 std::to_string(nm) + " (or none)");
   if (!(s.eddy.h >= 0.0) || !std::isfinite(s.eddy.h))
     throw std::invalid_argument("State eddy.h is negative or not finite");
+  auto sized = [](const auto& v, std::size_t n, const char* what) {
+    if (!v.empty() && v.size() != n)
+      throw std::invalid_argument(std::string("State does not fit the model: ") + what + " has " +
+                                  std::to_string(v.size()) + " entries, expected " +
+                                  std::to_string(n) + " (or none)");
+  };
+  sized(s.still_time, nb, "still_time");
+  sized(s.still_pos, nb, "still_pos");
+  sized(s.still_quat, nb, "still_quat");
+  sized(s.sleep_island, nb, "sleep_island");
+  sized(s.H_sleep, nm, "H_sleep");
+  for (std::size_t b = 0; b < s.sleep_island.size(); ++b)
+    if (s.sleep_island[b] < -1 || s.sleep_island[b] >= static_cast<int>(nb))
+      throw std::invalid_argument("State sleep_island[" + std::to_string(b) + "] is not a body index or -1");
   if (s.step < 0) throw std::invalid_argument("State step count is negative");
 }
 

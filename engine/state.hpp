@@ -54,6 +54,17 @@ struct State {
   /// moment's flux density in its body's frame over the last ODE step. Derived data as dvel:
   /// kept so that a restored state continues as the original; not part of the hash.
   EddyMemory eddy;
+  /// SimOptions::sleep (engine/sleep.cpp), derived data as dvel: kept so that a restored state
+  /// continues as the original; not part of the hash. Empty = nothing asleep, nobody still.
+  ///   still_time  (nbody) s each awake body has stayed near its still pose;
+  ///   still_pos, still_quat (nbody) the pose where that began (sleep.cpp);
+  ///   sleep_island (nbody) −1 = awake, else the island it sleeps in (its lowest body index);
+  ///   H_sleep     (nmoment) A/m, the field at a sleeping moment when its island fell asleep.
+  std::vector<double> still_time;
+  std::vector<Vec3> still_pos;
+  std::vector<Quat> still_quat;
+  std::vector<int> sleep_island;
+  std::vector<Vec3> H_sleep;
   /// mag.M is the converged magnetization at these poses (every state a step produced): the
   /// next step's first forces need no solve. false at t = 0 (unmagnetized). Not hashed.
   bool magnetized = false;

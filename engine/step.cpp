@@ -20,6 +20,7 @@
 #include "engine/simulation.hpp"
 
 #include "engine/ode_bridge.hpp"
+#include "engine/sleep.hpp"
 #include "engine/stages.hpp"
 #include "magnetics/coenergy.hpp"
 #include "magnetics/forces.hpp"
@@ -95,7 +96,14 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
     mz = state_.mag;
     next.eddy = state_.eddy;
     next.contact_depth = 0.0;
+    next.still_time = state_.still_time;
+    next.still_pos = state_.still_pos;
+    next.still_quat = state_.still_quat;
+    next.sleep_island = state_.sleep_island;
+    next.H_sleep = state_.H_sleep;
+    next.enabled = state_.enabled;
     place_moments(m, state_, &moments_, &mz);
+    freeze_sleeping(m, state_, &moments_);
   }
 
   const double h = m.options.dt / nsub;
@@ -138,6 +146,9 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
         double depth = 0.0;
         prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth);
         next.contact_depth = std::max(next.contact_depth, depth);
+        // a sleeping island touched by a moving body joins this sub-step
+        if (wake_touched(m, next.contact_pairs, moments_, ws_.F, ws_.tau, &next, ode_.get()) > 0)
+          freeze_sleeping(m, next, &moments_);
       }
       ScopedTimer q(&prof.quickstep_ms);
       try {
@@ -165,6 +176,7 @@ void Simulation::assemble_next(int nsub, double h, long n) {
     ode_->read_state(&next);
     next.step = n;
     check_bodies(m, next, n);
+    settle(m, &next, &ws_.fell_asleep);  // islands still for long enough fall asleep (v = 0)
     next.dvel.resize(m.nbody);
     for (int b = 0; b < m.nbody; ++b) next.dvel[b] = next.vel[b] - state_.vel[b];
     // energy audit: the work of the last ODE step (O(bodies)), with the forces it was given
@@ -175,9 +187,12 @@ void Simulation::assemble_next(int nsub, double h, long n) {
   {
     ScopedTimer t(&prof.sync_ms);
     place_moments(m, next, &moments_, &next.mag);
+    freeze_sleeping(m, next, &moments_);
   }
   solve_magnetics(&next.mag, true, n);
   next.magnetized = true;
+  // sleepers that an awake source's field moved wake; the new ones keep this field
+  finish_sleep(m, ws_.fell_asleep, ws_.mag.H, &next);
   // the load term of the next step's sub-steps: |Σ F_j|/m_b of the forces it starts with
   next.mag_accel.assign(m.nbody, 0.0);
   if (m.dynamic_moments)
@@ -212,6 +227,14 @@ void Simulation::step() {
   const SimOptions& o = m.options;
   const bool guard = o.energy_guard && m.resolved.force_has_energy;
 
+  // every body asleep and nothing moving: the step only advances the clock
+  if (inject_body_ < 0 && ws_.forces_ready && world_asleep(m, state_)) {
+    state_.step = n;
+    std::fill(state_.dvel.begin(), state_.dvel.end(), Vec3::Zero());
+    energy_.last = EnergyFlow{};
+    profile_.asleep = static_cast<int>(m.dynamic_bodies.size());
+    return;
+  }
   try {
     // (1b) the frame's rigid sub-steps (1 unless the scene allows more and bodies move fast)
     int nsub = choose_substeps(m, state_);
@@ -252,6 +275,7 @@ void Simulation::step() {
       nsub = std::min(2 * nsub, o.energy_guard_max_substeps);
     }
     commit(retakes, unresolved);
+    profile_.asleep = asleep_count(state_);
   } catch (const SimulationError&) {
     inject_body_ = -1;
     rollback();

@@ -42,6 +42,7 @@ int choose_substeps(const Model& m, const State& s) {
   // frame of the scene for a second). Its load still counts.
   auto consider = [&](int b, bool motion) {
     if (b < 0 || m.body_type[b] != BodyType::Dynamic) return;
+    if (o.sleep && !s.sleep_island.empty() && s.sleep_island[b] >= 0) return;  // not stepped
     if (motion) {
       const double dv = s.dvel.empty() ? 0.0 : s.dvel[b].norm();
       speed = std::max(speed, s.vel[b].norm() + dv);

@@ -37,6 +37,8 @@ struct Workspace {
   State sub_prev;                 ///< the state after the last sub-step (energy audit)
   State next;                     ///< the state being computed; swapped in when it checks out
   EnergyAudit audit;              ///< the energy audit being computed, committed with next
+  /// bodies that fell asleep at the attempt's end state (sleep.cpp: settle → finish_sleep)
+  std::vector<int> fell_asleep;
 };
 
 }  // namespace magsim::engine

@@ -106,7 +106,7 @@ double picard_iteration(const MomentDesc& set, Magnetization* mz, const Dynamics
   double max_change = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change)
   for (long j = 0; j < n; ++j) {
-    if (set.kind[j] != MomentKind::Induced) continue;
+    if (!set.solved(j)) continue;
     const double Ms = set.Ms[j];
     const Vec3 M_old = mz->M[j];
     mz->set_magnetization(j, curve_M(curve, ws->H[j], Ms), Ms);  // eq. 10
@@ -122,7 +122,7 @@ RelaxStats relax_anderson(const MomentDesc& set, Magnetization* mz, const Dynami
   AndersonHistory& h = ws->anderson;
   h.idx.clear();
   for (std::size_t j = 0; j < set.size(); ++j)
-    if (set.kind[j] == MomentKind::Induced) h.idx.push_back(static_cast<int>(j));
+    if (set.solved(j)) h.idx.push_back(static_cast<int>(j));
   const int depth = std::max(0, opt.anderson_depth);
   const std::size_t n = 3 * h.idx.size();
   for (auto* v : {&h.x, &h.g, &h.f, &h.x_prev, &h.f_prev}) v->resize(n);

@@ -210,7 +210,7 @@ SweepStats magnetization_iteration(const MomentDesc& set, Magnetization* mz,
   double max_change = 0.0, max_res = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change, max_res)
   for (long j = 0; j < n; ++j) {
-    if (set.kind[j] != MomentKind::Induced) continue;
+    if (!set.solved(j)) continue;
     const double Ms = set.Ms[j];
     const Vec3& H = ws->H[j];
     Vec3& M1 = mz->M1[j];

@@ -10,6 +10,7 @@
 #include "magnetics/types.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace magsim::mag {
@@ -29,9 +30,17 @@ struct MomentDesc {
   /// magnetic pull. 0 = a point (never bounded); set by the engine, 0 from add_*.
   std::vector<double> radius;
   Vec3 H0 = Vec3::Zero();           ///< uniform external field (A/m)
+  /// (n, or empty = none) 1 = an induced moment held at its magnetization: still a field
+  /// source, but the relaxation solvers leave it as it is (a sleeping body's moments,
+  /// engine/sleep.cpp). The exact solver does not read it.
+  std::vector<std::uint8_t> frozen;
 
   std::size_t size() const { return position.size(); }
   std::size_t induced_count() const;
+  /// Induced and not frozen: a moment the relaxation solvers update.
+  bool solved(std::size_t j) const {
+    return kind[j] == MomentKind::Induced && (frozen.empty() || !frozen[j]);
+  }
 };
 
 /// The magnetization of the moments of a MomentDesc, the state the dynamics evolve (induced

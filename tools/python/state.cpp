@@ -16,7 +16,7 @@ namespace magsim::python {
 
 namespace {
 
-constexpr char kMagic[8] = {'m', 'a', 'g', 's', 't', '0', '0', '1'};
+constexpr char kMagic[8] = {'m', 'a', 'g', 's', 't', '0', '0', '2'};
 
 // Plain bytes of trivially copyable values and of vectors of them (Vec3 and Quat are
 // fixed-size Eigen types of plain doubles).
@@ -97,6 +97,11 @@ void fields(IO& io, S& s) {
   f(s.contact_depth);
   f(s.eddy.B);
   f(s.eddy.h);
+  f(s.still_time);
+  f(s.still_pos);
+  f(s.still_quat);
+  f(s.sleep_island);
+  f(s.H_sleep);
   f(s.magnetized);
 }
 

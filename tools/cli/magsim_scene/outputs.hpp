@@ -3,6 +3,7 @@
 // and the frames (FrameRenderer).
 #pragma once
 
+#include "engine/sleep.hpp"
 #include "engine/simulation.hpp"
 #include "tools/cli/magsim_scene/magsim_scene.hpp"
 #ifdef MAGSIM_HAVE_RENDER
@@ -134,6 +135,7 @@ class Recorder {
     series_["substeps"].push_back(sim_.last_profile().substeps);
     series_["contact_depth"].push_back(sim_.state().contact_depth);  // the deepest overlap (m)
     series_["threads"].push_back(sim_.threads());
+    series_["asleep"].push_back(engine::asleep_count(s));  // bodies asleep (options.sleep)
     check();
     // the energy audit (engine/energy.hpp): state functions and cumulative work (J), and the
     // last step's magnetic and contact work (J per step)

@@ -278,10 +278,11 @@ int run_scene(const engine::SceneDesc& scene, const RunPlan& a) {
         last_report = now;
         std::fprintf(stderr,
                      "%s %s: step %ld/%ld  t = %.4f s  wall %.1f s  T_i %.3f  T_f %.3f  T_r %.3f ms  "
-                     "iterations %d%s  threads %d\n",
+                     "iterations %d%s  threads %d%s\n",
                      scene.name.c_str(), method.c_str(), sim.steps(), n_steps, sim.time(),
                      std::chrono::duration<double>(now - t0).count(), p.T_i, p.T_f, p.T_r, p.iterations,
-                     p.cap_hit ? " (cap)" : "", sim.threads());
+                     p.cap_hit ? " (cap)" : "", sim.threads(),
+                     sim.model().options.sleep ? ("  asleep " + std::to_string(p.asleep)).c_str() : "");
       }
     }
     record();  // the final (or last good) state, if not yet recorded

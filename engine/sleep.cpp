@@ -1,0 +1,223 @@
+// engine/sleep.cpp — sleeping islands (SimOptions::sleep).
+//
+// An island is a set of dynamic bodies joined by contacts. A body is still while it stays
+// near the pose (x_a, q_a) where its stillness began:
+//   |x − x_a| + r_b · 2|vec(q_a⁻¹ q)| ≤ sleep_speed · sleep_time     (r_b its bounding radius)
+// (2|vec| = 2 sin(θ/2): the turn θ, without a trig call); leaving that reach starts it again
+// from the new pose. So a body's mean speed over the window is below sleep_speed, while it may
+// jitter faster in place, as a pile's contacts make it do. An island falls asleep when every
+// body in it has been still for sleep_time. Asleep:
+//   - its bodies are disabled in ODE (no step, no gravity, no contact rows) with v = ω = 0;
+//   - its moments stay field sources, their magnetization frozen (MomentDesc::frozen): the
+//     relaxation leaves them as they are, so a sleeping island's own field never changes;
+//   - its forces are still summed with everyone's, but given to no body.
+// It wakes when
+//   - an awake dynamic body or a kinematic body touches one of its bodies (a contact found
+//     by a sub-step's collisions, before that sub-step's rigid step);
+//   - the field at one of its moments has moved by more than
+//       tol · max(|H_sleep|, 0.01 Ms)    (tol = sleep_field_tolerance; Ms → |M| for a magnet)
+//     since the island fell asleep: only awake sources can move it;
+//   - the user asks (Simulation::wake_all).
+// Every decision reads the State and the step's contacts, in body order: the same inputs
+// give the same islands on every path.
+#include "engine/sleep.hpp"
+
+#include "engine/ode_bridge.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace magsim::engine {
+
+namespace {
+
+bool asleep(const State& s, int b) { return !s.sleep_island.empty() && s.sleep_island[b] >= 0; }
+
+bool kinematic_moving(const Model& m, const State& s, int b) {
+  return b >= 0 && m.body_type[b] == BodyType::Kinematic &&
+         (s.vel[b] != Vec3::Zero() || s.angvel[b] != Vec3::Zero());
+}
+
+int find(std::vector<int>& parent, int a) {
+  while (parent[a] != a) {
+    parent[a] = parent[parent[a]];
+    a = parent[a];
+  }
+  return a;
+}
+
+void wake_island(const Model& m, int island, State* s, OdeBridge* ode) {
+  for (int b : m.dynamic_bodies) {
+    if (s->sleep_island[b] != island) continue;
+    s->sleep_island[b] = -1;
+    s->still_time[b] = 0.0;
+    s->still_pos[b] = s->pos[b];
+    s->still_quat[b] = s->quat[b];
+    s->enabled[b] = 1;
+    if (ode) ode->enable(b);
+  }
+}
+
+}  // namespace
+
+void prepare_sleep(const Model& m, State* s) {
+  if (!m.options.sleep) return;
+  s->still_time.resize(m.nbody, 0.0);
+  if (s->still_pos.size() != static_cast<std::size_t>(m.nbody)) {
+    s->still_pos = s->pos;
+    s->still_quat = s->quat;
+  }
+  s->sleep_island.resize(m.nbody, -1);
+  s->H_sleep.resize(m.nmoment, Vec3::Zero());
+}
+
+int asleep_count(const State& s) {
+  return static_cast<int>(std::count_if(s.sleep_island.begin(), s.sleep_island.end(),
+                                        [](int i) { return i >= 0; }));
+}
+
+bool world_asleep(const Model& m, const State& s) {
+  if (!m.options.sleep || m.dynamic_bodies.empty() || !s.magnetized) return false;
+  for (int b : m.dynamic_bodies)
+    if (!asleep(s, b)) return false;
+  for (int b = 0; b < m.nbody; ++b)
+    if (kinematic_moving(m, s, b)) return false;
+  return true;
+}
+
+void freeze_sleeping(const Model& m, const State& s, mag::MomentDesc* set) {
+  if (!m.options.sleep) return;
+  set->frozen.assign(m.nmoment, 0);
+  for (int j = 0; j < m.nmoment; ++j) set->frozen[j] = asleep(s, m.moment_body[j]) ? 1 : 0;
+}
+
+int wake_touched(const Model& m, const std::vector<std::pair<int, int>>& pairs,
+                 const mag::MomentDesc& set, const std::vector<Vec3>& F,
+                 const std::vector<Vec3>& tau, State* next, OdeBridge* ode) {
+  if (!m.options.sleep || asleep_count(*next) == 0) return 0;
+  int woken = 0;
+  auto mover = [&](int b) {
+    if (b < 0) return false;
+    if (m.body_type[b] == BodyType::Dynamic) return !asleep(*next, b);
+    return kinematic_moving(m, *next, b);
+  };
+  for (const auto& [a, b] : pairs) {
+    for (const auto& [sleeper, other] : {std::pair{a, b}, std::pair{b, a}}) {
+      if (sleeper < 0 || !asleep(*next, sleeper) || !mover(other)) continue;
+      const int island = next->sleep_island[sleeper];
+      for (int c : m.dynamic_bodies)
+        if (next->sleep_island[c] == island) ode->enable(c);  // ODE takes forces of enabled bodies
+      // the bodies join this sub-step with the magnetic forces everyone else was given
+      for (int c : m.dynamic_bodies) {
+        if (next->sleep_island[c] != island) continue;
+        for (int j = m.body_moment_adr[c]; j < m.body_moment_adr[c] + m.body_moment_num[c]; ++j) {
+          if (j >= static_cast<int>(F.size())) break;
+          ode->add_force_at(c, F[j], set.position[j]);
+          if (m.moment_permanent[j] && j < static_cast<int>(tau.size())) ode->add_torque(c, tau[j]);
+        }
+      }
+      wake_island(m, island, next, ode);
+      ++woken;
+    }
+  }
+  return woken;
+}
+
+void settle(const Model& m, State* next, std::vector<int>* fell_asleep) {
+  fell_asleep->clear();
+  if (!m.options.sleep) return;
+  const SimOptions& o = m.options;
+  // still time of the awake bodies; touching a moving kinematic body is never still
+  std::vector<std::uint8_t> pushed(m.nbody, 0);
+  for (const auto& [a, b] : next->contact_pairs) {
+    if (kinematic_moving(m, *next, a) && b >= 0) pushed[b] = 1;
+    if (kinematic_moving(m, *next, b) && a >= 0) pushed[a] = 1;
+  }
+  const double reach = o.sleep_speed * o.sleep_time;
+  for (int b : m.dynamic_bodies) {
+    if (asleep(*next, b)) continue;
+    const double turn = 2.0 * (next->still_quat[b].conjugate() * next->quat[b]).vec().norm();
+    const double drift = (next->pos[b] - next->still_pos[b]).norm() + m.body_radius[b] * turn;
+    if (pushed[b] || !(drift <= reach)) {  // moved on (or NaN): stillness starts again here
+      next->still_pos[b] = next->pos[b];
+      next->still_quat[b] = next->quat[b];
+      next->still_time[b] = 0.0;
+    } else {
+      next->still_time[b] += o.dt;
+    }
+  }
+  // islands of awake dynamic bodies (contacts with the ground, static and kinematic bodies
+  // do not join islands)
+  std::vector<int> parent(m.nbody);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto joins = [&](int b) { return b >= 0 && m.body_type[b] == BodyType::Dynamic && !asleep(*next, b); };
+  for (const auto& [a, b] : next->contact_pairs) {
+    if (!joins(a) || !joins(b)) continue;
+    const int ra = find(parent, a), rb = find(parent, b);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);  // the root: the lowest index
+  }
+  std::vector<std::uint8_t> restless(m.nbody, 0);
+  for (int b : m.dynamic_bodies)
+    if (!asleep(*next, b) && next->still_time[b] < o.sleep_time) restless[find(parent, b)] = 1;
+  for (int b : m.dynamic_bodies) {
+    if (asleep(*next, b) || restless[find(parent, b)]) continue;
+    fell_asleep->push_back(b);
+    next->vel[b] = Vec3::Zero();
+    next->angvel[b] = Vec3::Zero();
+    next->enabled[b] = 0;
+  }
+}
+
+int finish_sleep(const Model& m, const std::vector<int>& fell_asleep, const std::vector<Vec3>& H,
+                 State* next) {
+  if (!m.options.sleep || H.size() != static_cast<std::size_t>(m.nmoment)) return 0;
+  const double tol = m.options.sleep_field_tolerance;
+  // the islands asleep before this step: has an awake source moved the field at them?
+  std::vector<int> wake;
+  for (int b : m.dynamic_bodies) {
+    const int island = next->sleep_island[b];
+    if (island < 0 || std::find(wake.begin(), wake.end(), island) != wake.end()) continue;
+    for (int j = m.body_moment_adr[b]; j < m.body_moment_adr[b] + m.body_moment_num[b]; ++j) {
+      const double scale = m.moment_permanent[j] ? next->mag.M[j].norm() : m.moment_Ms[j];
+      const double limit = tol * std::max(next->H_sleep[j].norm(), 0.01 * scale);
+      if ((H[j] - next->H_sleep[j]).norm() > limit) {
+        wake.push_back(island);
+        break;
+      }
+    }
+  }
+  for (int island : wake) wake_island(m, island, next, nullptr);
+  // the islands that fell asleep at this state: their magnetization is converged (they were
+  // solved free), and this is the field they are held against; an island's id is its lowest
+  // body index, found again from the contacts among them
+  if (!fell_asleep.empty()) {
+    std::vector<int> parent(m.nbody);
+    std::iota(parent.begin(), parent.end(), 0);
+    std::vector<std::uint8_t> fell(m.nbody, 0);
+    for (int b : fell_asleep) fell[b] = 1;
+    for (const auto& [a, b] : next->contact_pairs) {
+      if (a < 0 || b < 0 || !fell[a] || !fell[b]) continue;
+      const int ra = find(parent, a), rb = find(parent, b);
+      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    for (int b : fell_asleep) {
+      next->sleep_island[b] = find(parent, b);
+      next->still_time[b] = 0.0;
+      for (int j = m.body_moment_adr[b]; j < m.body_moment_adr[b] + m.body_moment_num[b]; ++j)
+        next->H_sleep[j] = H[j];
+    }
+  }
+  return static_cast<int>(wake.size());
+}
+
+void wake_all(const Model& m, State* s) {
+  if (s->sleep_island.empty()) return;
+  for (int b : m.dynamic_bodies)
+    if (s->sleep_island[b] >= 0) {
+      s->sleep_island[b] = -1;
+      s->still_time[b] = 0.0;
+      s->enabled[b] = 1;
+    }
+}
+
+}  // namespace magsim::engine
