@@ -210,7 +210,11 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "magsolve: --residual-tol: must be a finite number > 0\n");
     return kBadInput;
   }
+  // magsolve's own starting point, not the engine's: one configuration solved from scratch by
+  // the paper's method to 1e-6 within 999 sweeps (the case's "magnetics", then the flags, override it)
   mag::DynamicsOptions opt;
+  opt.tol = tol;
+  opt.max_iter = max_iter;
   if (!mag::parse_method(method_name, &opt.method)) {
     std::fprintf(stderr, "magsolve: %s\n", mag::kMethodNames.unknown("method", method_name).c_str());
     return kBadInput;
