@@ -4,9 +4,9 @@
 // ("bh_theta"), its kind, default, unit, range, magsim-scene flag and one line of doc. The
 // structs' in-class initialisers equal the table's defaults, so that a default-constructed
 // SimOptions (or mag::DynamicsOptions) is the defaults. The scene-file reader and writer
-// (scenes/options_json.cpp), the range checks (compile_model), magsim-scene's option flags
-// (tools/cli/option_flags.hpp), magsolve's flag ranges and summary.json's "options" all go
-// through the table, so that an option is read, written, checked and offered as a flag alike;
+// (scenes/options_json.cpp), the range checks (compile_model), the option flags of magsim-scene,
+// magsolve and bench (tools/cli/option_flags.hpp) and summary.json's "options" all go through the
+// table, so that an option is read, written, checked and offered as a flag alike;
 // tests/engine/options_table_test.cpp holds the structs and scenes/SCENE_FILE.md to it.
 #pragma once
 
