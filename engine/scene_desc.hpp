@@ -101,7 +101,7 @@ struct SimOptions {
   /// (tools/findings/falling_magnet.md).
   bool balance_magnetic_torque = false;
   /// The force on induced moments; Method (the default) is the method's own pairing
-  /// (resolved_force_model below).
+  /// (mag::resolve_force_model, applied once by compile_model into Model::resolved).
   mag::ForceModel force_model = mag::ForceModel::Method;
   /// Energy guard, for conservative forces (classic, zeeman-total; eq. 4 has no energy and is
   /// never guarded): a rigid step whose E = K + U_g + U* rises by more than
@@ -181,17 +181,6 @@ struct SimOptions {
   /// hence 1000 rather than 100. 0 = off. (Kept last in the struct.)
   double max_body_speed = 1000.0;
 };
-
-/// The force on induced moments that `o` resolves to (mag::resolve_force_model): never
-/// ForceModel::Method.
-inline mag::ForceModel resolved_force_model(const SimOptions& o) {
-  return mag::resolve_force_model(o.force_model, o.magnetics.method);
-}
-/// The resolved force is the gradient of an energy (classic: −∇U*; zeeman-total: −∇E_sys), so
-/// the energy guard can check it. eq. 4 (zeeman) is not.
-inline bool force_conservative(const SimOptions& o) {
-  return resolved_force_model(o) != mag::ForceModel::Zeeman;
-}
 
 struct SceneDesc {
   std::string name;
