@@ -1,8 +1,8 @@
 // engine/apply_forces.cpp — stage 3 of a step (Algorithm 1, "compute F using eq. 4"): one
 // field + Jacobian evaluation at the converged magnetizations gives the force on every
-// moment (the resolved force model, resolved_force_model: classic eqs. 13–14 by default and for
-// Kim 2018, Zeeman eq. 4 for the paper's θ dynamics)
-// and the torque on permanent moments (τ = μ0 m × H); they act on the dynamic bodies.
+// moment (the force model compile_model resolved, Model::resolved: classic eqs. 13–14 by
+// default and for Kim 2018, Zeeman eq. 4 for the paper's θ dynamics) and the torque on
+// permanent moments (τ = μ0 m × H); they act on the dynamic bodies.
 #include "engine/stages.hpp"
 
 #include "magnetics/forces.hpp"

@@ -57,6 +57,17 @@ std::string body_where(int i, const std::string& name) {
   return "body " + std::to_string(i) + " '" + name + "'";
 }
 
+// The method resolved: the only place the method and force_model are turned into a curve and a
+// force law (Model::Resolved), so that no stage works them out again.
+Model::Resolved resolve(const SimOptions& o) {
+  Model::Resolved r;
+  r.curve = mag::curve_of(o.magnetics.method);
+  r.force = mag::resolve_force_model(o.force_model, o.magnetics.method);
+  // classic (−∇U*) and zeeman-total (−∇E_sys) are gradients of an energy; eq. 4 (zeeman) is not
+  r.force_has_energy = r.force != mag::ForceModel::Zeeman;
+  return r;
+}
+
 // Each option in its range (engine/options_table.hpp: the scene file's, the flags'), then
 // what no single option's range says: the machine's thread cap and the combinations.
 void check_options(const SimOptions& o, const Vec3& H0) {
@@ -77,11 +88,11 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
   // the pair model is a correction of U*: only the classic force is its gradient
-  if (o.magnetics.field.near_field.model == mag::NearField::Pair &&
-      resolved_force_model(o) != mag::ForceModel::Classic)
+  const mag::ForceModel force = resolve(o).force;
+  if (o.magnetics.field.near_field.model == mag::NearField::Pair && force != mag::ForceModel::Classic)
     fail("options.magnetics.field.near_field.model", std::string("pair needs the classic force (the default's); method '") +
                                    mag::method_name(o.magnetics.method) + "' with force '" +
-                                   mag::kForceModelNames.name(resolved_force_model(o)) +
+                                   mag::kForceModelNames.name(force) +
                                    "' has no energy for it to correct");
 }
 
@@ -249,10 +260,7 @@ Model compile_model(const SceneDesc& scene) {
 
   Model m;
   m.options = scene.options;
-  m.resolved.curve = mag::curve_of(scene.options.magnetics.method);
-  m.resolved.force = resolved_force_model(scene.options);
-  m.resolved.exact = scene.options.magnetics.method == mag::Method::Exact;
-  m.resolved.force_has_energy = force_conservative(scene.options);
+  m.resolved = resolve(scene.options);
   m.H0 = scene.H0;
   if (const std::string e = camera_error(scene.camera); !e.empty()) fail("camera", e);
   m.camera = scene.camera;

@@ -37,7 +37,6 @@ struct Model {
   struct Resolved {
     mag::Curve curve = mag::Curve::Tanh;               ///< the magnetization curve f
     mag::ForceModel force = mag::ForceModel::Classic;  ///< the force on induced moments
-    bool exact = false;  ///< Method::Exact: M = f(H(M)) by Newton (ground truth), no relaxation
     bool force_has_energy = true;  ///< the force is −∇ of an energy, so the energy guard can check it
   } resolved;
   Vec3 H0 = Vec3::Zero();  ///< uniform external field (A/m)

@@ -1,12 +1,13 @@
 // engine/options_table.hpp — every run option (SimOptions with its mag::DynamicsOptions and
 // mag::FieldOptions) declared once, in options_table.cpp: its key in a scene file's "options"
 // (the member's own path, "magnetics.field.bh_theta"), the key files written before used
-// ("bh_theta"), its kind, unit, range, magsim-scene flag and one line of doc. Its default is
-// the struct's. The scene-file reader and writer (scenes/options_json.cpp), the range checks
-// (compile_model), magsim-scene's option flags (tools/cli/option_flags.hpp), magsolve's flag ranges
-// and summary.json's "options" all go through the table, so that an option is read, written,
-// checked and offered as a flag alike; tests/engine/options_table_test.cpp holds
-// scenes/SCENE_FILE.md to it.
+// ("bh_theta"), its kind, default, unit, range, magsim-scene flag and one line of doc. The
+// structs' in-class initialisers equal the table's defaults, so that a default-constructed
+// SimOptions (or mag::DynamicsOptions) is the defaults. The scene-file reader and writer
+// (scenes/options_json.cpp), the range checks (compile_model), the option flags of magsim-scene,
+// magsolve and bench (tools/cli/option_flags.hpp) and summary.json's "options" all go through the
+// table, so that an option is read, written, checked and offered as a flag alike;
+// tests/engine/options_table_test.cpp holds the structs and scenes/SCENE_FILE.md to it.
 #pragma once
 
 #include "engine/scene_desc.hpp"
@@ -95,6 +96,7 @@ struct OptionSpec {
   std::string flag;      ///< magsim-scene's flag ("" = none)
   bool flag_switch = false;  ///< Bool: the flag takes no value and turns the option on
   std::string doc;       ///< one line: what it does (magsim-scene's --help says it)
+  OptionValue def;       ///< its default; the member's in-class initialiser equals it
   std::function<OptionValue(const SimOptions&)> get;
   /// Stores a value that error() accepts (a Name by one of `names`).
   std::function<void(SimOptions&, const OptionValue&)> set;
@@ -102,8 +104,8 @@ struct OptionSpec {
   /// "" when v is a value of this option (its kind, range, names), else why not, in the scene
   /// file's wording: "must be in (0, 1] (got 1.5)", "unknown method 'x' (ours, ...)".
   std::string error(const OptionValue& v) const;
-  /// Its value in a default SimOptions: the struct's default member initialisers.
-  OptionValue default_value() const { return get(SimOptions{}); }
+  /// Its default, declared in the table; equal to its value in a default-constructed SimOptions.
+  const OptionValue& default_value() const { return def; }
   /// The values it takes, for SCENE_FILE.md and --help: "a number in (0, 0.1]", "true or
   /// false", "\"sap\", \"hash\", \"simple\"", "[x, y, z] of length <= 1e+06".
   std::string values_text() const;

@@ -83,21 +83,9 @@ inline bool parse_space(const std::string& name, SpaceKind* out) { return kSpace
 /// and every member of DynamicsOptions and FieldOptions, is declared in the table of options
 /// (engine/options_table.cpp), under its path as the scene-file key.
 struct SimOptions {
-  /// The magnetization solve: its method, Δt_m, β, tolerance, cap … The method (the scene
-  /// file's "magnetics.method") defaults to anderson: Anderson-accelerated M = f(H(M)) with
-  /// the classic force converges every rigid (sub-)step and makes the force −∇U*
-  /// (magnetics/coenergy.hpp), so passive scenes lose energy and come to rest. `ours` is the
-  /// paper as printed (θ dynamics eqs. 8–11, eq. 4), whose force has no energy. Scenes stop
-  /// the sweeps when the residual max_j |M_j − f(H_j)|/Ms_j < 1e-4 (DynamicsOptions::
-  /// criterion, default Residual) or after 100 sweeps per rigid step: warm-started from the
-  /// last step, a converging method needs a handful; a cap hit is counted in the profile.
-  mag::DynamicsOptions magnetics = [] {
-    mag::DynamicsOptions d;
-    d.method = mag::Method::Anderson;
-    d.tol = 1e-4;
-    d.max_iter = 100;
-    return d;
-  }();
+  /// The magnetization solve: its method, Δt_m, β, tolerance, cap … (defaults in
+  /// mag::DynamicsOptions, equal to the table's).
+  mag::DynamicsOptions magnetics;
   /// Apply the Zeeman force pairwise antisymmetrized (mag::compute_forces): momentum is
   /// conserved. false (default) = the per-moment gradient of eq. 4, which breaks action =
   /// reaction: harmless against a fixed magnet, but in falling_magnet the dynamic magnet and
@@ -113,7 +101,7 @@ struct SimOptions {
   /// (tools/findings/falling_magnet.md).
   bool balance_magnetic_torque = false;
   /// The force on induced moments; Method (the default) is the method's own pairing
-  /// (resolved_force_model below).
+  /// (mag::resolve_force_model, applied once by compile_model into Model::resolved).
   mag::ForceModel force_model = mag::ForceModel::Method;
   /// Energy guard, for conservative forces (classic, zeeman-total; eq. 4 has no energy and is
   /// never guarded): a rigid step whose E = K + U_g + U* rises by more than
@@ -204,17 +192,6 @@ struct SimOptions {
   /// hence 1000 rather than 100. 0 = off. (Kept last in the struct.)
   double max_body_speed = 1000.0;
 };
-
-/// The force on induced moments that `o` resolves to (mag::resolve_force_model): never
-/// ForceModel::Method.
-inline mag::ForceModel resolved_force_model(const SimOptions& o) {
-  return mag::resolve_force_model(o.force_model, o.magnetics.method);
-}
-/// The resolved force is the gradient of an energy (classic: −∇U*; zeeman-total: −∇E_sys), so
-/// the energy guard can check it. eq. 4 (zeeman) is not.
-inline bool force_conservative(const SimOptions& o) {
-  return resolved_force_model(o) != mag::ForceModel::Zeeman;
-}
 
 struct SceneDesc {
   std::string name;

@@ -9,6 +9,7 @@
 
 #include "magnetics/anderson.hpp"
 #include "magnetics/curves.hpp"
+#include "magnetics/ground_truth.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -237,6 +238,15 @@ SweepStats magnetization_iteration(const MomentDesc& set, Magnetization* mz,
 RelaxStats relax_magnetization(
     const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt, MagWorkspace* ws,
     const std::function<void(int, const Magnetization&)>& on_iteration) {
+  if (opt.method == Method::Exact) {
+    const ExactStats ex = solve_exact(set, mz, curve_of(opt.method), opt.field);
+    RelaxStats st;
+    st.iterations = ex.newton_steps;
+    st.converged = ex.converged;
+    st.last_change = st.last_residual = ex.residual;
+    if (on_iteration) on_iteration(st.iterations, *mz);
+    return st;
+  }
   if (opt.method == Method::Anderson) return relax_anderson(set, mz, opt, ws, on_iteration);
   RelaxStats st;
   for (int k = 1; k <= opt.max_iter; ++k) {

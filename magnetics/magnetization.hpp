@@ -31,10 +31,14 @@ inline SweepStats magnetization_iteration(MomentSet* set, const DynamicsOptions&
   return magnetization_iteration(*set, set, opt, ws);
 }
 
-/// Sweeps until converged or opt.max_iter; warm-starts from the magnetization *mz of the
-/// moments `set`. `on_iteration(k, *mz)` (optional) is called after sweep k = 1, 2, …
-/// Method::Anderson runs the Anderson-accelerated Picard solve of magnetics/anderson.hpp
-/// instead (one field evaluation per iteration, the same stopping rule and cap).
+/// The one entry point that solves the magnetization by opt.method, so that no caller chooses
+/// between the solvers: the dynamics sweep until converged or opt.max_iter, warm-started from
+/// the magnetization *mz of the moments `set`, `on_iteration(k, *mz)` (optional) called after
+/// sweep k = 1, 2, …; Method::Anderson runs the Anderson-accelerated Picard solve of
+/// magnetics/anderson.hpp (one field evaluation per iteration, the same stopping rule and cap);
+/// Method::Exact the Newton ground truth (ground_truth.hpp, its own tolerance and cap:
+/// iterations = Newton steps, last_change = last_residual = its final residual, on_iteration
+/// called once at the end).
 RelaxStats relax_magnetization(
     const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt, MagWorkspace* ws,
     const std::function<void(int, const Magnetization&)>& on_iteration = {});

@@ -20,8 +20,14 @@ enum class ThetaIntegrator : std::uint8_t {
 inline constexpr NameTable<ThetaIntegrator, 2> kThetaIntegratorNames{
     {{ThetaIntegrator::Exact, "exact"}, {ThetaIntegrator::Euler, "euler"}}};
 
+/// The magnetization solve's options. The in-class defaults are the engine's, equal to the
+/// table of run options (engine/options_table.cpp, whose test holds them equal): a caller that
+/// wants another method, tolerance or cap (the paper's ours at 1e-6, magsolve) sets it.
 struct DynamicsOptions {
-  Method method = Method::Ours;
+  /// Anderson-accelerated M = f(H(M)) with the classic force converges every rigid (sub-)step
+  /// and makes the force −∇U* (magnetics/coenergy.hpp), so passive scenes lose energy and come
+  /// to rest; `ours` is the paper as printed (θ dynamics eqs. 8–11, eq. 4), with no energy.
+  Method method = Method::Anderson;
   double dt = 100e-9;          ///< Δt_m, magnetization clock step (s); allowed [1 ns, 1 µs]
   double beta = 5.0;           ///< β of eq. 8 (m·A⁻¹·s⁻¹); 0.005 per (ns·MA/m), our reading of the unit
   double alpha = 0.2;          ///< LLG damping constant α of eq. 6 (Kim 2018: 0.2–0.25)
@@ -33,13 +39,15 @@ struct DynamicsOptions {
   /// The raised bound is used only while it is ≤ min(adaptive_gamma_cap, 2/k), k = β Δt Ms
   /// (beyond, |H| ≳ 2.5 Ms and the fixed bound applies again: |M| = Ms to < 1e-6).
   double adaptive_gamma_cap = 2.5;
-  double tol = 1e-6;           ///< converged when the criterion's value < tol
+  /// Converged when the criterion's value < tol: warm-started from the last rigid step, a
+  /// converging method needs a handful of sweeps to 1e-4.
+  double tol = 1e-4;
   /// What tol bounds. Residual (default): max_j |M_j − f(H_j)|/Ms_j of the iterate the
   /// sweep's fields came from — free, since H is computed anyway, and it does not stop a
   /// slow method early the way a small per-sweep change does. Change: max_j |ΔM_j|/Ms_j over
   /// one sweep (magnetics/PHYSICS.md's wording).
   enum class Criterion : std::uint8_t { Residual, Change } criterion = Criterion::Residual;
-  int max_iter = 999;          ///< iteration cap per solve
+  int max_iter = 100;          ///< iteration cap per solve (a hit is counted in the profile)
   /// Floor (rad) of the half-angle between M_j1 and M_j2: a pair closer than this is spread
   /// back to it about M (|M| changes by < φ²/2 = 5e-13 relative), so the two
   /// sub-magnetizations can never collapse onto each other.

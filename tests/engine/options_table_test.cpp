@@ -1,8 +1,8 @@
 // tests/engine/options_table_test.cpp — the table of run options (engine/options_table.hpp):
 // each entry reaches its own member and no other, round-trips through the scene file's JSON
 // under its key and under its older one, is checked by compile_model in the range the scene
-// file takes (which lies within mag::validate's), and scenes/SCENE_FILE.md lists exactly the
-// table's options with their keys, defaults and values.
+// file takes (which lies within mag::validate's), its default is the structs' in-class one, and
+// scenes/SCENE_FILE.md lists exactly the table's options with their keys, defaults and values.
 #include "engine/model.hpp"
 #include "engine/options_table.hpp"
 #include "scenes/options_json.hpp"
@@ -88,6 +88,27 @@ std::vector<std::vector<std::string>> table_rows(const std::string& text, const 
 
 }  // namespace
 
+// The one default of each option is the table's; the structs' in-class initialisers must equal
+// it, both in a SimOptions and in each struct constructed on its own (so that no owner overrides
+// a member's initialiser, and a library caller that builds a mag::DynamicsOptions gets the same).
+TEST_CASE("options table: default-constructed structs hold the table's default of every option", "[options_table]") {
+  const SimOptions whole;
+  SimOptions parts;
+  parts.magnetics = mag::DynamicsOptions{};
+  parts.magnetics.field = mag::FieldOptions{};
+  parts.magnetics.field.near_field = mag::NearFieldOptions{};
+  std::size_t checked = 0;
+  for (const OptionSpec& s : engine::options_table()) {
+    INFO("options." << s.key << ": table default " << engine::value_text(s.default_value(), s.kind)
+                    << ", struct " << engine::value_text(s.get(whole), s.kind) << ", on its own "
+                    << engine::value_text(s.get(parts), s.kind));
+    CHECK(s.get(whole) == s.default_value());
+    CHECK(s.get(parts) == s.default_value());
+    ++checked;
+  }
+  CHECK(checked == engine::options_table().size());
+}
+
 TEST_CASE("options table: every entry reaches its own member and no other", "[options_table]") {
   const SimOptions defaults;
   std::set<std::string> keys;
@@ -95,7 +116,7 @@ TEST_CASE("options table: every entry reaches its own member and no other", "[op
     INFO("options." << s.key);
     CHECK(keys.insert(s.key).second);
     CHECK(!s.doc.empty());
-    CHECK(s.error(s.default_value()).empty());  // the struct's default is a value of the option
+    CHECK(s.error(s.default_value()).empty());  // the default is a value of the option
     SimOptions o;
     s.set(o, test::probe(s));
     CHECK(s.error(test::probe(s)).empty());

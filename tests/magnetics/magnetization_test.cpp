@@ -220,3 +220,18 @@ TEST_CASE("dynamics options are validated", "[dynamics]") {
   o.field.softening = std::nan("");
   CHECK_FALSE(validate(o).empty());
 }
+
+TEST_CASE("relax_magnetization is the one entry point: Method::Exact is the Newton solve", "[dynamics]") {
+  MomentSet a = magsim::test::cluster(200.0), b = a;
+  DynamicsOptions o;
+  o.method = Method::Exact;
+  MagWorkspace ws;
+  int calls = 0;
+  const RelaxStats st = relax_magnetization(&a, o, &ws, [&](int, const MomentSet&) { ++calls; });
+  const ExactStats ex = solve_exact(&b, curve_of(Method::Exact), o.field);
+  CHECK(st.converged == ex.converged);
+  CHECK(st.iterations == ex.newton_steps);
+  CHECK(st.last_residual == ex.residual);
+  CHECK(calls == 1);
+  for (std::size_t j = 0; j < a.size(); ++j) CHECK(a.M[j] == b.M[j]);
+}

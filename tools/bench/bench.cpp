@@ -3,13 +3,13 @@
 // iterations per step, and the ratio ours/Kim 2018 of T_i measured in the same run; plus the
 // scaling of the step with the number of balls (sakura_tree with N balls). Writes JSON.
 // Timings are figures to read, never pass/fail. --field-solver / --bh-theta / --bh-threshold
-// set the dipole-field summation of every run; the scaling runs use --scaling-solver (default
+// (the table of run options' flags, as magsim-scene's) set the dipole-field summation of every run; the scaling runs use --scaling-solver (default
 // auto: Barnes–Hut from --bh-threshold moments on), or --field-solver when only that is given.
 // --near-field-cost measures every scene and method twice in the same run, with the near field
 // `dipole` and `pair`, and writes the ratio pair/dipole of T_i + T_f + T_r per step.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
-#include "tools/cli/field_flags.hpp"
+#include "tools/cli/option_flags.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -69,7 +69,7 @@ struct Window {
 };
 
 Window measure(const std::string& scene, mag::Method method, int count, int warmup, int steps,
-               int threads, const magsim::tools::FieldFlags& field,
+               int threads, const magsim::tools::OptionFlags& field,
                std::optional<mag::FieldSolver> solver = std::nullopt,
                std::optional<mag::NearField> near_field = std::nullopt) {
   magsim::scenes::SceneParams p;
@@ -77,7 +77,7 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
   d.options.magnetics.method = method;
   if (threads > 0) d.options.threads = threads;
-  field.apply(&d.options.magnetics.field);
+  field.apply(&d.options);  // checked in main
   if (solver) d.options.magnetics.field.solver = *solver;
   if (near_field) d.options.magnetics.field.near_field.model = *near_field;
   eng::Simulation sim(d);
@@ -148,7 +148,11 @@ int main(int argc, char** argv) {
   int warmup = 400, steps = 100, threads = 0, scaling_steps = 30, scaling_warmup = 500;
   std::string scaling_solver = "auto";
   bool near_field_cost = false;
-  magsim::tools::FieldFlags field;
+  // the field flags are the table's (magsim-scene's spellings, ranges and help)
+  magsim::tools::OptionFlags::Offer offer;
+  offer.keys = {"magnetics.field.solver", "magnetics.field.bh_theta", "magnetics.field.auto_threshold",
+                "magnetics.field.near_field.model", "magnetics.field.near_field.mu_r"};
+  magsim::tools::OptionFlags field;
   app.add_option("--scenes", scenes, "comma list of registry scenes")->capture_default_str();
   app.add_option("--methods", methods, "comma list of methods")->capture_default_str();
   app.add_option("--warmup", warmup, "steps before the window")->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -158,7 +162,7 @@ int main(int argc, char** argv) {
   app.add_option("--scaling-methods", scaling_methods, "methods for the scaling runs")->capture_default_str();
   app.add_option("--scaling-steps", scaling_steps, "window of each scaling run")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--scaling-warmup", scaling_warmup, "steps before each scaling window")->check(CLI::NonNegativeNumber)->capture_default_str();
-  field.add(&app, mag::kFieldSolverNames.list(" | ") + ": dipole-field summation of every run (default: the scene's, auto)");
+  field.add(&app, "Options", offer);
   app.add_option("--scaling-solver", scaling_solver,
                  "field solver of the scaling runs (default auto, or --field-solver when only that is given)")
       ->capture_default_str();
@@ -167,18 +171,20 @@ int main(int argc, char** argv) {
                "the ratio pair/dipole of T_i + T_f + T_r per step (not with --near-field)");
   app.add_option("--json", out, "where to write the JSON")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  if (near_field_cost && field.near_opt->count()) {
+  if (near_field_cost && field.given("magnetics.field.near_field.model")) {
     std::fprintf(stderr, "bench: --near-field-cost measures both near fields; do not give --near-field with it\n");
     return 2;
   }
 
   // the scaling runs: --scaling-solver, or --field-solver when only that is given
-  if (!app.count("--scaling-solver") && field.has_solver()) scaling_solver = field.solver;
+  const bool solver_given = field.given("magnetics.field.solver");
+  if (!app.count("--scaling-solver") && solver_given) scaling_solver = field.text("magnetics.field.solver");
   mag::FieldSolver scaling_field;
+  eng::SimOptions requested;  // the table's defaults with the flags given, for the JSON
   try {
-    field.check();
-    if (field.has_solver()) magsim::tools::FieldFlags::parse(field.solver, "--field-solver");
-    scaling_field = magsim::tools::FieldFlags::parse(scaling_solver, "--scaling-solver");
+    field.apply(&requested);
+    if (!mag::parse_field_solver(scaling_solver, &scaling_field))
+      throw std::invalid_argument("--scaling-solver: " + mag::kFieldSolverNames.unknown("solver", scaling_solver));
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "bench: %s\n", e.what());
     return 2;
@@ -208,10 +214,10 @@ int main(int argc, char** argv) {
   doc["scaling_warmup_steps"] = scaling_warmup;
   doc["scaling_window_steps"] = scaling_steps;
   // requested for the Table 1 runs (each run records the one used)
-  doc["field_solver"] = field.has_solver() ? field.solver : "scene default";
+  doc["field_solver"] = solver_given ? field.text("magnetics.field.solver") : "scene default";
   doc["scaling_solver"] = scaling_solver;
-  doc["bh_theta"] = field.theta;
-  doc["bh_threshold"] = field.threshold;
+  doc["bh_theta"] = requested.magnetics.field.bh_theta;
+  doc["bh_threshold"] = requested.magnetics.field.auto_threshold;
   doc["runs"] = json::array();
   std::printf("%-15s %-15s %9s %9s %9s %9s %7s %6s %-10s   paper T_i/T_f/T_r (ms per frame)\n",
               "scene", near_field_cost ? "method/near" : "method", "T_i", "T_f", "T_r", "total", "iters", "cap%", "solver");

@@ -12,6 +12,7 @@
 #include "scenes/options_json.hpp"
 #include "scenes/text_file.hpp"
 #include "tools/cli/cli_common.hpp"
+#include "tools/cli/option_flags.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -150,27 +151,27 @@ int run(int argc, char** argv) {
       "F_classic (eq. 13) in newtons, the force of --force-model with --near-field as F_model,\n"
       "the iterations taken, convergence, and e_M (eq. 12) against the Newton ground truth of\n"
       "the method's curve (eq. 10; eq. 7 for kim2018)."};
-  std::string path, method_name = "ours", format = "json", force_model_name = "classic",
-              near_field_name = "dipole";
-  double mu_r = 1000.0;
-  double dt = 100e-9, tol = 1e-6, softening = 0.0, residual_tol = 1e-3;
-  int max_iter = 999;
+  std::string path, format = "json", force_model_name = "classic";
+  double residual_tol = 1e-3;
+  // The magnetics flags are the table's (magsim-scene's spellings and ranges); magsolve's older
+  // spellings stay as aliases. Its starting point is its own, not the engine's: one configuration
+  // solved from scratch by the paper's method to 1e-6 within 999 sweeps; the case's
+  // "magnetics", then the flags, override it.
+  magsim::tools::OptionFlags::Offer offer;
+  offer.keys = {"magnetics.method", "magnetics.dt", "magnetics.tol", "magnetics.max_iter",
+                "magnetics.field.softening", "magnetics.field.near_field.model",
+                "magnetics.field.near_field.mu_r"};
+  offer.older = {{"magnetics.dt", {"--dt"}}, {"magnetics.field.near_field.mu_r", {"--mu-r"}}};
+  offer.defaults.magnetics.method = mag::Method::Ours;
+  offer.defaults.magnetics.tol = 1e-6;
+  offer.defaults.magnetics.max_iter = 999;
+  offer.source = "the case's ";
+  magsim::tools::OptionFlags flags;
   app.add_option("case", path,
                  "CASE.json: {\"external_field\": [Hx,Hy,Hz], \"moments\": [...], \"magnetics\": {...}} "
                  "(magnetics: a scene file's options.magnetics; the flags below override it)")
       ->required();
-  app.add_option("--method", method_name, mag::kMethodNames.list("|"))->capture_default_str();
-  // one spelling per option in every program (magsim-scene's, engine/options_table.cpp); the
-  // older spellings of magsolve stay as aliases
-  app.add_option("--dt-m,--dt", dt, "magnetization step Δt_m in seconds, [1e-9, 1e-6] (--dt: the older spelling)")
-      ->check(magsim::tools::OptionCheck("magnetics.dt"))->capture_default_str();
-  app.add_option("--tol", tol, "converged when every |ΔM|/Ms < tol in one iteration, in (0, 1)")
-      ->check(magsim::tools::OptionCheck("magnetics.tol"))->capture_default_str();
-  app.add_option("--max-iter", max_iter, "iteration cap, in [1, 1000000]")->check(magsim::tools::OptionCheck("magnetics.max_iter"))->capture_default_str();
-  app.add_option("--softening", softening,
-                 "softening length ε in metres (0 = off; needed for two moments closer than half "
-                 "the sum of their radii, a = the radius of a sphere of the moment's volume), in [0, 0.1]")
-      ->check(magsim::tools::OptionCheck("magnetics.field.softening"))->capture_default_str();
+  flags.add(&app, "Options", offer);
   app.add_option("--residual-tol", residual_tol,
                  "\"converged\" needs the iteration to stop (--tol) and every induced moment's "
                  "|M - f(H)| <= this x max(|M|, |f(H)|)")
@@ -179,15 +180,6 @@ int run(int argc, char** argv) {
                  "the force printed as F_model: " + mag::kForceModelNames.list("|") +
                      " (method: the method's own pairing; classic is the engine's default, -grad U*)")
       ->capture_default_str();
-  app.add_option("--near-field", near_field_name,
-                 "near field of touching induced spheres: " + mag::kNearFieldNames.list("|") +
-                     " (pair: exact two-sphere couplings faded by saturation, magnetics/near_field.hpp; "
-                     "it changes M, H and every force printed, and needs the classic F_model)")
-      ->capture_default_str();
-  app.add_option("--near-field-mu-r,--mu-r", mu_r,
-                 "initial relative permeability of the induced material, read by --near-field pair, in "
-                 "[10, 10000] (iron: 1000) (--mu-r: the older spelling)")
-      ->check(magsim::tools::OptionCheck("magnetics.field.near_field.mu_r"))->capture_default_str();
   app.add_option("--format", format, "json|csv")->check(CLI::IsMember({"json", "csv"}))
       ->capture_default_str();
   app.footer(magsim::tools::exit_codes_footer(
@@ -210,9 +202,12 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "magsolve: --residual-tol: must be a finite number > 0\n");
     return kBadInput;
   }
-  mag::DynamicsOptions opt;
-  if (!mag::parse_method(method_name, &opt.method)) {
-    std::fprintf(stderr, "magsolve: %s\n", mag::kMethodNames.unknown("method", method_name).c_str());
+  mag::DynamicsOptions opt = offer.defaults.magnetics;
+  try {  // a name the table lacks is refused before the case is read
+    mag::DynamicsOptions probe = opt;
+    flags.apply(&probe);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "magsolve: %s\n", e.what());
     return kBadInput;
   }
   mag::ForceModel model_choice = mag::ForceModel::Classic;
@@ -220,7 +215,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "magsolve: %s\n", mag::kForceModelNames.unknown("--force-model", force_model_name).c_str());
     return kBadInput;
   }
-  const mag::ForceModel force_model = mag::resolve_force_model(model_choice, opt.method);
+  mag::ForceModel force_model = model_choice;  // resolved below, once the method is known
   mag::MomentSet set;
   try {
     std::string text;
@@ -240,16 +235,8 @@ int run(int argc, char** argv) {
     const magsim::scenes::JsonReader r(path);
     r.keys(doc, "", {"external_field", "moments", "magnetics"});
     if (doc.contains("magnetics")) magsim::scenes::from_json(r, doc["magnetics"], "magnetics", &opt);
-    // flags given on the command line override the case's "magnetics"
-    if (app.count("--method")) mag::parse_method(method_name, &opt.method);  // a valid name: checked above
-    if (app.count("--dt-m")) opt.dt = dt;
-    if (app.count("--tol")) opt.tol = tol;
-    if (app.count("--max-iter")) opt.max_iter = max_iter;
-    if (app.count("--softening")) opt.field.softening = softening;
-    if (app.count("--near-field") &&
-        !mag::kNearFieldNames.parse(near_field_name, &opt.field.near_field.model))
-      throw InputError(mag::kNearFieldNames.unknown("--near-field", near_field_name));
-    if (app.count("--near-field-mu-r")) opt.field.near_field.mu_r = mu_r;
+    flags.apply(&opt);  // flags given on the command line override the case's "magnetics"
+    force_model = mag::resolve_force_model(model_choice, opt.method);
     if (const std::string e = mag::validate(opt); !e.empty()) {
       std::fprintf(stderr, "magsolve: %s\n", e.c_str());
       return kBadInput;

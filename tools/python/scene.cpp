@@ -78,24 +78,23 @@ Scene parse(const std::string* path, const std::string& text, const std::string&
   return s;
 }
 
+// The name of every entry of a table (the registry, the options), in the table's order.
+template <class Table, class Name>
+std::vector<std::string> names_of(const Table& table, Name name) {
+  std::vector<std::string> names;
+  for (const auto& e : table) names.emplace_back(name(e));
+  return names;
+}
+
 }  // namespace
 
 void bind_scene(py::module_& m) {
   m.def(
-      "scene_names",
-      [] {
-        std::vector<std::string> names;
-        for (const scenes::SceneEntry& e : scenes::registry()) names.emplace_back(e.name);
-        return names;
-      },
+      "scene_names", [] { return names_of(scenes::registry(), [](const scenes::SceneEntry& e) { return e.name; }); },
       "The registry's scenes (magsim-scene --list).");
   m.def(
       "option_keys",
-      [] {
-        std::vector<std::string> keys;
-        for (const engine::OptionSpec& s : engine::options_table()) keys.push_back(s.key);
-        return keys;
-      },
+      [] { return names_of(engine::options_table(), [](const engine::OptionSpec& s) { return s.key; }); },
       "Every option's key in the scene file's spelling (\"magnetics.field.bh_theta\"), in the table's order.");
   m.def(
       "options_table",

@@ -81,28 +81,11 @@ void fields(IO& io, S& s) {
     if constexpr (std::is_same_v<IO, Writer>) io.put(x);
     else io.get(&x);
   };
-  f(s.step);
-  f(s.pos);
-  f(s.quat);
-  f(s.vel);
-  f(s.angvel);
-  f(s.enabled);
-  f(s.mag.M1);
-  f(s.mag.M2);
-  f(s.mag.M);
-  f(s.mag.seeded);
-  f(s.contact_pairs);
-  f(s.dvel);
-  f(s.mag_accel);
-  f(s.contact_depth);
-  f(s.eddy.B);
-  f(s.eddy.h);
-  f(s.still_time);
-  f(s.still_pos);
-  f(s.still_quat);
-  f(s.sleep_island);
-  f(s.H_sleep);
-  f(s.magnetized);
+  // a comma fold runs left to right: the bytes keep this order
+  auto each = [&f](auto&... x) { (f(x), ...); };
+  each(s.step, s.pos, s.quat, s.vel, s.angvel, s.enabled, s.mag.M1, s.mag.M2, s.mag.M, s.mag.seeded,
+       s.contact_pairs, s.dvel, s.mag_accel, s.contact_depth, s.eddy.B, s.eddy.h, s.still_time,
+       s.still_pos, s.still_quat, s.sleep_island, s.H_sleep, s.magnetized);
 }
 
 }  // namespace
