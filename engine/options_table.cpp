@@ -342,8 +342,8 @@ std::vector<OptionSpec> build() {
               "change of the field at a moment beyond sleep_field_tolerance, or by the user")
           .flag("--sleep"),
       number(MEMBER(sleep_speed), 0.02, above(0), "m/s",
-             "a body is still while it stays within sleep_speed * sleep_time of the pose where it came to "
-             "rest (|dx| + r_body |dtheta|): its mean speed over the window")
+             "a body is still while its mean velocities over the last sleep_time/2 give |v| + |omega| r_body "
+             "below this (omega left out for spheres with centred induced moments)")
           .flag("--sleep-speed"),
       number(MEMBER(sleep_time), 0.1, above(0), "s", "how long every body of an island must be still before it sleeps")
           .flag("--sleep-time"),

@@ -163,8 +163,8 @@ struct SimOptions {
   SpaceKind space = SpaceKind::SweepAndPrune;
   bool auto_disable = false;       ///< ODE auto-disable of resting bodies
   /// Sleeping islands (engine/sleep.cpp): an island of dynamic bodies joined by contacts falls
-  /// asleep when every body has stayed for sleep_time within sleep_speed × sleep_time of the
-  /// pose where it came to rest (|Δx| + r_body |Δθ|: a mean speed, jitter in place allowed);
+  /// asleep when every body's mean velocities over the last sleep_time/2 have given
+  /// |v̄| + |ω̄| r_body < sleep_speed for sleep_time (jitter in place averages out);
   /// asleep, its bodies leave ODE's step and its moments stay field sources with their
   /// magnetization frozen. It wakes when an awake body touches it, or when the field at one of
   /// its moments has moved since it fell asleep by more than sleep_field_tolerance × |H| (at

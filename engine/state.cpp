@@ -96,8 +96,8 @@ void check_state_shape(const Model& m, const State& s) {
                                   std::to_string(n) + " (or none)");
   };
   sized(s.still_time, nb, "still_time");
-  sized(s.still_pos, nb, "still_pos");
-  sized(s.still_quat, nb, "still_quat");
+  sized(s.still_vel, nb, "still_vel");
+  sized(s.still_angvel, nb, "still_angvel");
   sized(s.sleep_island, nb, "sleep_island");
   sized(s.H_sleep, nm, "H_sleep");
   for (std::size_t b = 0; b < s.sleep_island.size(); ++b)

@@ -56,13 +56,13 @@ struct State {
   EddyMemory eddy;
   /// SimOptions::sleep (engine/sleep.cpp), derived data as dvel: kept so that a restored state
   /// continues as the original; not part of the hash. Empty = nothing asleep, nobody still.
-  ///   still_time  (nbody) s each awake body has stayed near its still pose;
-  ///   still_pos, still_quat (nbody) the pose where that began (sleep.cpp);
+  ///   still_time  (nbody) s each awake body has been still for;
+  ///   still_vel, still_angvel (nbody) its mean velocities (sleep.cpp);
   ///   sleep_island (nbody) −1 = awake, else the island it sleeps in (its lowest body index);
   ///   H_sleep     (nmoment) A/m, the field at a sleeping moment when its island fell asleep.
   std::vector<double> still_time;
-  std::vector<Vec3> still_pos;
-  std::vector<Quat> still_quat;
+  std::vector<Vec3> still_vel;
+  std::vector<Vec3> still_angvel;
   std::vector<int> sleep_island;
   std::vector<Vec3> H_sleep;
   /// mag.M is the converged magnetization at these poses (every state a step produced): the

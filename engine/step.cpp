@@ -97,8 +97,8 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
     next.eddy = state_.eddy;
     next.contact_depth = 0.0;
     next.still_time = state_.still_time;
-    next.still_pos = state_.still_pos;
-    next.still_quat = state_.still_quat;
+    next.still_vel = state_.still_vel;
+    next.still_angvel = state_.still_angvel;
     next.sleep_island = state_.sleep_island;
     next.H_sleep = state_.H_sleep;
     next.enabled = state_.enabled;

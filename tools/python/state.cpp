@@ -85,7 +85,7 @@ void fields(IO& io, S& s) {
   auto each = [&f](auto&... x) { (f(x), ...); };
   each(s.step, s.pos, s.quat, s.vel, s.angvel, s.enabled, s.mag.M1, s.mag.M2, s.mag.M, s.mag.seeded,
        s.contact_pairs, s.dvel, s.mag_accel, s.contact_depth, s.eddy.B, s.eddy.h, s.still_time,
-       s.still_pos, s.still_quat, s.sleep_island, s.H_sleep, s.magnetized);
+       s.still_vel, s.still_angvel, s.sleep_island, s.H_sleep, s.magnetized);
 }
 
 }  // namespace

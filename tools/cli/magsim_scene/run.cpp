@@ -321,6 +321,18 @@ int run_scene(const engine::SceneDesc& scene, const RunPlan& a) {
   char hash[19];
   std::snprintf(hash, sizeof hash, "%016" PRIx64, sim.state_hash());
   auto stats = [](const std::vector<double>& v) { return json{{"median", median(v)}, {"total", sum(v)}}; };
+  // means per step of T_i, T_f, T_r and the whole step over steps [from, from + n)
+  const long per_half = std::max<long>(1, std::lround(0.5 / model.options.dt));
+  auto phase = [&](long from, long n) {
+    auto mean = [&](const std::vector<double>& v) {
+      const long a = std::min<long>(from, static_cast<long>(v.size()));
+      const long b = std::min<long>(from + n, static_cast<long>(v.size()));
+      double acc = 0.0;
+      for (long k = a; k < b; ++k) acc += v[k];
+      return b > a ? acc / static_cast<double>(b - a) : 0.0;
+    };
+    return json{{"T_i", mean(Ti)}, {"T_f", mean(Tf)}, {"T_r", mean(Tr)}, {"step", mean(total)}};
+  };
   json summary{
       {"scene", scene.name},
       {"source", ends_with(a.source, ".json") ? a.source : "registry"},
@@ -356,7 +368,11 @@ int run_scene(const engine::SceneDesc& scene, const RunPlan& a) {
         {"T_r", stats(Tr)},
         {"collide", stats(collide)},
         {"quickstep", stats(quickstep)},
-        {"step", stats(total)}}},
+        {"step", stats(total)},
+        // what the motion and the rest cost: means per step over the run's first and last 0.5 s
+        {"first_half_second", phase(0, per_half)},
+        {"last_half_second", phase(std::max<long>(0, static_cast<long>(total.size()) - per_half), per_half)}}},
+      {"wall_per_simulated_second", sim.time() > 0 ? wall / sim.time() : 0.0},
       // OpenMP threads of the magnetics per step: adaptive = chosen from the other processes'
       // load (cpu_share.hpp), else the fixed count of --threads / options.threads / OMP_NUM_THREADS
       {"threads",
