@@ -119,6 +119,78 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   return w;
 }
 
+// A whole run, as a user pays for it: the scene's standard run (or `seconds`), wall time per
+// simulated second, the means per step of its first and last 0.5 s, and the warm window's
+// medians (steps [warmup, warmup + steps)) from the same run.
+struct WholeRun {
+  double seconds = 0, wall = 0;
+  double first[4] = {0, 0, 0, 0}, last[4] = {0, 0, 0, 0};  ///< T_i, T_f, T_r, step (ms)
+  Window window;
+  int asleep = 0;  ///< bodies asleep at the end
+  bool failed = false;
+  std::string error;
+};
+
+WholeRun whole_run(const std::string& scene, mag::Method method, int count, double seconds, int warmup,
+                   int steps, int threads, const magsim::tools::OptionFlags& field) {
+  magsim::scenes::SceneParams p;
+  p.count = count;
+  eng::SceneDesc d = magsim::scenes::find_scene(scene)->build(p);
+  d.options.magnetics.method = method;
+  if (threads > 0) d.options.threads = threads;
+  field.apply(&d.options);
+  eng::Simulation sim(d);
+  const long n = std::lround((seconds > 0 ? seconds : d.default_seconds) / d.options.dt);
+  const long half = std::max<long>(1, std::lround(0.5 / d.options.dt));
+  std::vector<double> ti, tf, tr, tot;
+  WholeRun r;
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  auto last_report = t0;
+  try {
+    for (long k = 0; k < n; ++k) {
+      sim.step();
+      const eng::StepProfile& pr = sim.last_profile();
+      ti.push_back(pr.T_i);
+      tf.push_back(pr.T_f);
+      tr.push_back(pr.T_r);
+      tot.push_back(pr.total_ms);
+      if (clock::now() - last_report > std::chrono::seconds(10)) {
+        last_report = clock::now();
+        std::fprintf(stderr, "bench: %s %s step %ld/%ld, %d asleep\n", scene.c_str(),
+                     mag::method_name(method), k + 1, n, pr.asleep);
+      }
+    }
+  } catch (const std::exception& e) {
+    r.failed = true;
+    r.error = e.what();
+  }
+  r.wall = std::chrono::duration<double>(clock::now() - t0).count();
+  r.seconds = sim.time();
+  r.asleep = sim.last_profile().asleep;
+  const long m = static_cast<long>(tot.size());
+  auto mean = [](const std::vector<double>& v, long a, long b) {
+    double acc = 0;
+    for (long k = a; k < b; ++k) acc += v[k];
+    return b > a ? acc / static_cast<double>(b - a) : 0.0;
+  };
+  const std::vector<double>* parts[4] = {&ti, &tf, &tr, &tot};
+  for (int q = 0; q < 4; ++q) {
+    r.first[q] = mean(*parts[q], 0, std::min(m, half));
+    r.last[q] = mean(*parts[q], std::max(0L, m - half), m);
+  }
+  if (m >= warmup + steps) {
+    std::vector<double> a(ti.begin() + warmup, ti.begin() + warmup + steps), b(tf.begin() + warmup, tf.begin() + warmup + steps),
+        c(tr.begin() + warmup, tr.begin() + warmup + steps), t(steps);
+    for (int k = 0; k < steps; ++k) t[k] = a[k] + b[k] + c[k];
+    r.window.T_i = median(a);
+    r.window.T_f = median(b);
+    r.window.T_r = median(c);
+    r.window.total = median(t);
+  }
+  return r;
+}
+
 json window_json(const Window& w) {
   json j = {{"timing_ms", {{"T_i", {{"median", w.T_i}}}, {"T_f", {{"median", w.T_f}}},
                            {"T_r", {{"median", w.T_r}}}, {"total", {{"median", w.total}}}}},
@@ -151,7 +223,7 @@ int main(int argc, char** argv) {
   // the field flags are the table's (magsim-scene's spellings, ranges and help)
   magsim::tools::OptionFlags::Offer offer;
   offer.keys = {"magnetics.field.solver", "magnetics.field.bh_theta", "magnetics.field.auto_threshold",
-                "magnetics.field.near_field.model", "magnetics.field.near_field.mu_r"};
+                "magnetics.field.near_field.model", "magnetics.field.near_field.mu_r", "sleep"};
   magsim::tools::OptionFlags field;
   app.add_option("--scenes", scenes, "comma list of registry scenes")->capture_default_str();
   app.add_option("--methods", methods, "comma list of methods")->capture_default_str();
@@ -169,6 +241,17 @@ int main(int argc, char** argv) {
   app.add_flag("--near-field-cost", near_field_cost,
                "measure every scene and method twice, with --near-field dipole and pair, and print "
                "the ratio pair/dipole of T_i + T_f + T_r per step (not with --near-field)");
+  bool whole = false;
+  double whole_seconds = 0;
+  int whole_count = 0;
+  app.add_flag("--whole-run", whole,
+               "instead of the Table 1 windows: each scene's whole standard run per method, wall time per "
+               "simulated second, the means per step of its first and last 0.5 s, and the warm window's medians "
+               "from the same run (what a user pays)");
+  app.add_option("--whole-run-seconds", whole_seconds, "with --whole-run: simulated seconds (0: the scene's standard run)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--whole-run-count", whole_count, "with --whole-run: balls / letters of the registry scenes (0: the scene's)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--json", out, "where to write the JSON")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (near_field_cost && field.given("magnetics.field.near_field.model")) {
@@ -219,6 +302,36 @@ int main(int argc, char** argv) {
   doc["bh_theta"] = requested.magnetics.field.bh_theta;
   doc["bh_threshold"] = requested.magnetics.field.auto_threshold;
   doc["runs"] = json::array();
+  if (whole) {
+    doc["whole_run"] = json::array();
+    std::printf("%-15s %-15s %10s %10s %28s %28s %22s %7s\n", "scene", "method", "sim s", "wall/sim s",
+                "first 0.5 s T_i/T_f/T_r", "last 0.5 s T_i/T_f/T_r", "window T_i/T_f/T_r", "asleep");
+    for (const std::string& s : split(scenes))
+      for (const auto& [name, m] : ms) {
+        const WholeRun r = whole_run(s, m, whole_count, whole_seconds, warmup, steps, threads, field);
+        json j = {{"scene", s}, {"method", name}, {"count", whole_count}, {"simulated_seconds", r.seconds},
+                  {"wall_seconds", r.wall}, {"wall_per_simulated_second", r.seconds > 0 ? r.wall / r.seconds : 0.0},
+                  {"first_half_second_ms", {{"T_i", r.first[0]}, {"T_f", r.first[1]}, {"T_r", r.first[2]}, {"step", r.first[3]}}},
+                  {"last_half_second_ms", {{"T_i", r.last[0]}, {"T_f", r.last[1]}, {"T_r", r.last[2]}, {"step", r.last[3]}}},
+                  {"window_median_ms", {{"T_i", r.window.T_i}, {"T_f", r.window.T_f}, {"T_r", r.window.T_r}, {"total", r.window.total}}},
+                  {"asleep_at_end", r.asleep}};
+        for (const PaperRow& pr : kPaper)
+          if (s == pr.scene) {
+            const double* v = m == mag::Method::Kim2018 ? pr.kim : pr.ours;
+            j["paper_wall_per_simulated_second"] = (v[0] + v[1] + v[2]);  // ms per 1 ms frame = s per s
+          }
+        if (r.failed) j["error"] = r.error;
+        doc["whole_run"].push_back(j);
+        std::printf("%-15s %-15s %10.3f %10.2f %10.2f/%7.2f/%8.2f %10.2f/%7.2f/%8.2f %7.2f/%6.2f/%7.2f %7d%s%s\n",
+                    s.c_str(), name.c_str(), r.seconds, r.seconds > 0 ? r.wall / r.seconds : 0.0, r.first[0], r.first[1],
+                    r.first[2], r.last[0], r.last[1], r.last[2], r.window.T_i, r.window.T_f, r.window.T_r, r.asleep,
+                    r.failed ? "  FAILED: " : "", r.failed ? r.error.c_str() : "");
+        std::fflush(stdout);
+      }
+    std::ofstream(out) << doc.dump(2) << "\n";
+    std::printf("bench: wrote %s\n", out.c_str());
+    return 0;
+  }
   std::printf("%-15s %-15s %9s %9s %9s %9s %7s %6s %-10s   paper T_i/T_f/T_r (ms per frame)\n",
               "scene", near_field_cost ? "method/near" : "method", "T_i", "T_f", "T_r", "total", "iters", "cap%", "solver");
   // the near fields of the Table 1 runs: the scene's (or --near-field's), or both
