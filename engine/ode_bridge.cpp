@@ -303,6 +303,10 @@ struct OdeBridge::Impl {
     const auto* t2 = static_cast<const GeomTag*>(dGeomGetData(o2));
     if (!t1->dynamic && !t2->dynamic) return;  // two non-dynamic bodies never interact
     if (t1->body == t2->body) return;          // geoms of one rigid body
+    // a sleeping body (disabled: SimOptions::sleep) against a sleeping or non-dynamic one: no
+    // row for ODE to solve; the step carries such pairs over (sleep.cpp)
+    auto rests = [](const GeomTag* t, dGeomID g) { return !t->dynamic || !dBodyIsEnabled(dGeomGetBody(g)); };
+    if (self->model.options.sleep && rests(t1, o1) && rests(t2, o2)) return;
     if (t1->shape > t2->shape) {
       std::swap(o1, o2);
       std::swap(t1, t2);

@@ -137,6 +137,19 @@ int wake_touched(const Model& m, const std::vector<std::pair<int, int>>& pairs,
   return woken;
 }
 
+void carry_sleeping_pairs(const Model& m, const std::vector<std::pair<int, int>>& before, State* next) {
+  if (!m.options.sleep || asleep_count(*next) == 0) return;
+  auto rests = [&](int b) { return b < 0 || m.body_type[b] != BodyType::Dynamic || asleep(*next, b); };
+  const std::size_t n = next->contact_pairs.size();
+  for (const auto& [a, b] : before)
+    if (rests(a) && rests(b) && (asleep(*next, std::max(a, b)) || (a >= 0 && asleep(*next, a))))
+      next->contact_pairs.emplace_back(a, b);
+  if (next->contact_pairs.size() == n) return;
+  std::sort(next->contact_pairs.begin(), next->contact_pairs.end());
+  next->contact_pairs.erase(std::unique(next->contact_pairs.begin(), next->contact_pairs.end()),
+                            next->contact_pairs.end());
+}
+
 void settle(const Model& m, State* next, std::vector<int>* fell_asleep) {
   fell_asleep->clear();
   if (!m.options.sleep) return;

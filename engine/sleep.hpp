@@ -28,6 +28,9 @@ void freeze_sleeping(const Model& m, const State& s, mag::MomentDesc* set);
 int wake_touched(const Model& m, const std::vector<std::pair<int, int>>& pairs,
                  const mag::MomentDesc& set, const std::vector<Vec3>& F,
                  const std::vector<Vec3>& tau, State* next, OdeBridge* ode);
+/// ODE's collisions skip pairs of sleeping and non-dynamic bodies: carries those of `before`
+/// (the last state's pairs) with at least one sleeping body into next->contact_pairs, sorted.
+void carry_sleeping_pairs(const Model& m, const std::vector<std::pair<int, int>>& before, State* next);
 /// At a step's end state, before its audit: the awake bodies' still time, and the islands
 /// that fall asleep now (v = ω = 0, enabled 0), listed in *fell_asleep. Their sleep_island
 /// is set by finish_sleep, after the end state's solve (they are solved free).

@@ -147,8 +147,15 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
         prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth);
         next.contact_depth = std::max(next.contact_depth, depth);
         // a sleeping island touched by a moving body joins this sub-step
-        if (wake_touched(m, next.contact_pairs, moments_, ws_.F, ws_.tau, &next, ode_.get()) > 0)
+        // (a woken island may touch another one: until none wakes)
+        while (wake_touched(m, next.contact_pairs, moments_, ws_.F, ws_.tau, &next, ode_.get()) > 0) {
           freeze_sleeping(m, next, &moments_);
+          // the woken bodies' contacts with sleeping and static bodies were skipped: again
+          ode_->discard_contacts();
+          prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth);
+          next.contact_depth = std::max(next.contact_depth, depth);
+        }
+        carry_sleeping_pairs(m, state_.contact_pairs, &next);
       }
       ScopedTimer q(&prof.quickstep_ms);
       try {
