@@ -1,7 +1,9 @@
 // Tests for magnetics/near_field.cpp, the near-field pair model: two iron balls against the
 // exact linear two-sphere forces (transverse and axial, weak field) and against the nonlinear
 // finite-element table (axial, g = 0.003a–0.3a, H0/Ms = 0.001–3); the dipole model beyond the
-// cut-off; momentum. That its forces are −∇U* is in coenergy_test.cpp.
+// cut-off; momentum; its forces are −∇U* (here for pairs and chains across the widened gap's
+// range, and in coenergy_test.cpp for random sets).
+#include "magnetics/coenergy.hpp"
 #include "magnetics/forces.hpp"
 #include "magnetics/ground_truth.hpp"
 #include "magnetics/near_field.hpp"
@@ -9,7 +11,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 
 using namespace magsim::mag;
 using magsim::test::ball_volume;
@@ -39,6 +43,53 @@ double upper_force(double g, const Vec3& H0, NearField model) {
   compute_forces(s, ForceModel::Classic, Curve::Tanh, f, &ws, &F, &tau);
   CHECK(std::abs(F[0].z() + F[1].z()) <= 1e-12 * std::abs(F[1].z()));  // action = reaction
   return F[1].z();
+}
+
+
+// U* at the exact magnetization of s (J)
+double coenergy_at(MomentSet s, const FieldOptions& f) {
+  REQUIRE(solve_exact(&s, Curve::Tanh, f, 1e-14, 100).residual < 1e-11);
+  FieldWorkspace ws;
+  std::vector<Vec3> H;
+  compute_fields(s, f, &H, nullptr, &ws);
+  return magnetic_coenergy(s, Curve::Tanh, H);
+}
+
+// −dU*/dt by central differences of step d, Richardson-extrapolated from d and d/2
+// (error O(d⁴)), where move(s, t) displaces one coordinate by t
+double minus_dU(const MomentSet& s, const FieldOptions& f, double d,
+                const std::function<void(MomentSet*, double)>& move) {
+  auto central = [&](double e) {
+    MomentSet p = s, m = s;
+    move(&p, e);
+    move(&m, -e);
+    return -(coenergy_at(p, f) - coenergy_at(m, f)) / (2 * e);
+  };
+  return (4 * central(0.5 * d) - central(d)) / 3;
+}
+
+// A tilted pair at gap g (radii) and a bent chain of four with gaps g, 1.5g, g (its second
+// neighbours 1.5–1.6a apart at g ≤ 0.03, in the cut-off step), a magnet below them and H0 of h Ms. The
+// magnet adds a fifth of h Ms at 25 mm, so H_app varies across the balls (its gradient is
+// what moves G on the magnet's and the balls' forces).
+MomentSet pair_and_chain(double g, double h) {
+  MomentSet s;
+  const double a = kBallRadius;
+  const Vec3 pc(-0.025, 0.002, 0.004), axis = Vec3(0.6, -0.48, 0.64);
+  s.add_induced(pc - 0.5 * (2 + g) * a * axis, ball_volume(), kIronMs);
+  s.add_induced(pc + 0.5 * (2 + g) * a * axis, ball_volume(), kIronMs);
+  const Vec3 dirs[3] = {Vec3(1, 0, 0), Vec3(0.5, 0, 0.866025403784), Vec3(1, 0, 0.05).normalized()};
+  const double gaps[3] = {g, 1.5 * g, g};
+  Vec3 p(0.006, -0.001, 0.002);
+  s.add_induced(p, ball_volume(), kIronMs);
+  for (int k = 0; k < 3; ++k) {
+    p += (2 + gaps[k]) * a * dirs[k];
+    s.add_induced(p, ball_volume(), kIronMs);
+  }
+  const double r = 0.025, Hm = 0.2 * h * kIronMs;  // on-axis dipole field 2m/(4π r³) = Hm
+  s.add_permanent(Vec3(0, 0, -r), 1e-6, Vec3(0.2, -0.1, 1.0).normalized() * (2 * kPi * r * r * r * Hm));
+  s.H0 = Vec3(0.3, -0.2, 1.0).normalized() * (h * kIronMs);
+  return s;
 }
 
 }  // namespace
@@ -222,4 +273,50 @@ TEST_CASE("pair model: the cached couplings follow the description", "[near_fiel
   }
   CHECK(field(s, &reused)[0] != field(moved, &reused)[0]);
   CHECK(field(s, &reused)[0] != field(turned, &reused)[0]);
+}
+
+TEST_CASE("pair model: forces and the magnet's torque are -grad U* across the widened gap",
+          "[near_field]") {
+  // central differences of U* (every magnetization re-solved), against the classic forces on
+  // every ball and the magnet and the magnet's torque; gaps 0.003a–0.3a, H0 from the linear
+  // range through the knee to saturation (G = g_e + κ h^q from g_e to past the table's end)
+  FieldOptions f = with_model(NearField::Pair);
+  double worst_F = 0, worst_T = 0;
+  for (double g : {0.003, 0.03, 0.3}) {
+    for (double h : {0.001, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0}) {
+      MomentSet s = pair_and_chain(g, h);
+      NearFieldWorkspace nws;
+      find_near_pairs(s, &nws);
+      // the pair, three contacts, and (below g = 0.3a) two second neighbours
+      REQUIRE(nws.pairs.size() == (g < 0.3 ? 6u : 4u));
+      MomentSet solved = s;
+      REQUIRE(solve_exact(&solved, Curve::Tanh, f, 1e-14, 100).residual < 1e-11);
+      MagWorkspace mws;
+      std::vector<Vec3> F, tau;
+      compute_forces(solved, ForceModel::Classic, Curve::Tanh, f, &mws, &F, &tau);
+      double Fmax = 0;
+      for (const Vec3& x : F) Fmax = std::max(Fmax, x.norm());
+      double eF = 0, eT = 0;
+      const int magnet = static_cast<int>(s.size()) - 1;
+      for (int j = 0; j <= magnet; ++j)
+        for (int c = 0; c < 3; ++c) {
+          const double Ffd = minus_dU(s, f, 1e-8, [&](MomentSet* t, double d) { t->position[j][c] += d; });
+          eF = std::max(eF, std::abs(Ffd - F[j][c]) / Fmax);
+        }
+      for (int c = 0; c < 3; ++c) {  // the magnet turned about its centre
+        const double Tfd = minus_dU(s, f, 1e-6, [&](MomentSet* t, double d) {
+          t->m_perm[magnet] = Eigen::AngleAxisd(d, Vec3::Unit(c)).toRotationMatrix() * t->m_perm[magnet];
+          t->M[magnet] = t->m_perm[magnet] / t->volume[magnet];
+        });
+        eT = std::max(eT, std::abs(Tfd - tau[magnet][c]) / tau[magnet].norm());
+      }
+      INFO("g/a " << g << ", H0/Ms " << h << ": force error " << eF << ", torque error " << eT
+                  << " (|F|max " << Fmax << " N)");
+      CHECK(eF < 1e-6);
+      CHECK(eT < 1e-6);
+      worst_F = std::max(worst_F, eF);
+      worst_T = std::max(worst_T, eT);
+    }
+  }
+  WARN("worst relative error: force " << worst_F << ", magnet torque " << worst_T);
 }
