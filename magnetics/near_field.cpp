@@ -95,36 +95,41 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
   perp2_ = spline_second(perp_, table_step());
 }
 
-// G = g_e(g) + κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = κ q h^{q−1}
-double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh) {
+// G = g_e(g) + s κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = s κ q h^{q−1}
+double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh, double s) {
   double dge = 0;
   const double ge = pair_effective_gap(g, &dge);
-  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  const double w = h > 0 ? s * kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
   if (dG_dg) *dG_dg = dge;
   if (dG_dh) *dG_dh = h > 0 ? kPairWidenPower * w / h : 0.0;
   return ge + w;
 }
 
-// Δt(g, h) = spline(ln G(g, h)); ∂Δt/∂g = spline'(x) (dG/dg)/G, ∂Δt/∂h = spline'(x) (dG/dh)/G
-PairCoupling PairCouplingTable::at(double g, double h) const {
+// Δt(g, h, s) = spline(ln G(g, h, s)); ∂Δt/∂g = spline'(x) (∂G/∂g)/G, and so for h and s
+// (∂G/∂s = κ h^q)
+PairCoupling PairCouplingTable::at(double g, double h, double s) const {
   double dGg = 0, dGh = 0;
-  const double G = pair_widened_gap(g, h, &dGg, &dGh);
+  const double G = pair_widened_gap(g, h, &dGg, &dGh, s);
+  const double dGs = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
   const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
   spline_eval(par_, par2_, x, &c.par, &d);
   c.dpar = d * dGg / G;
   c.dpar_dh = d * dGh / G;
+  c.dpar_ds = d * dGs / G;
   spline_eval(perp_, perp2_, x, &c.perp, &d);
   c.dperp = d * dGg / G;
   c.dperp_dh = d * dGh / G;
+  c.dperp_ds = d * dGs / G;
   return c;
 }
 
-// S(g) = 1 − (10 s³ − 15 s⁴ + 6 s⁵), s = (g − g_full)/(g_cut − g_full) ∈ [0, 1]
-double pair_switch(double g, double* dS_dg) {
-  const double w = kPairCutoffGap - kPairFullGap;
-  const double s = (g - kPairFullGap) / w;
+namespace {
+// 1 − (10 s³ − 15 s⁴ + 6 s⁵), s = (g − g_full)/(g_cut − g_full) ∈ [0, 1]
+double quintic_step(double g, double g_full, double g_cut, double* dS_dg) {
+  const double w = g_cut - g_full;
+  const double s = (g - g_full) / w;
   if (s <= 0) {
     if (dS_dg) *dS_dg = 0;
     return 1.0;
@@ -135,6 +140,13 @@ double pair_switch(double g, double* dS_dg) {
   }
   if (dS_dg) *dS_dg = -30.0 * s * s * (1.0 - s) * (1.0 - s) / w;
   return 1.0 - s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+}
+}  // namespace
+
+double pair_switch(double g, double* dS_dg) { return quintic_step(g, kPairFullGap, kPairCutoffGap, dS_dg); }
+
+double pair_count_switch(double g, double* dS_dg) {
+  return quintic_step(g, kPairCountFullGap, kPairCountCutoffGap, dS_dg);
 }
 
 const PairCouplingTable& NearFieldWorkspace::table_for(double mu_r) {
@@ -202,6 +214,14 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   }
   std::sort(ws->pairs.begin(), ws->pairs.end(),
             [](const NearPair& p, const NearPair& q) { return p.i != q.i ? p.i < q.i : p.j < q.j; });
+  // n_i = Σ_k S_c(g_ik): every contact is a near pair (kPairCountCutoffGap < kPairCutoffGap)
+  ws->count.assign(n, 0.0);
+  for (const NearPair& p : ws->pairs) {
+    const double g = (set.position[p.i] - set.position[p.j]).norm() / ws->a[p.i] - 2.0;
+    const double c = pair_count_switch(g);
+    ws->count[p.i] += c;
+    ws->count[p.j] += c;
+  }
 }
 
 namespace {
@@ -211,7 +231,10 @@ struct PairGeometry {
   double rho = 0, a = 0, g = 0;
   double A = 0, B = 0, dA = 0, dB = 0;  // Δt∥/a³, Δt⊥/a³ at G and d/dρ
   double hA = 0, hB = 0;                 // ∂A/∂h, ∂B/∂h
+  double nA = 0, nB = 0;                 // ∂A/∂ν, ∂B/∂ν
   double S = 0, dS = 0;                  // switch and dS/dρ
+  double w = 1, dw = 0;                  // ν^−β and d/dν
+  double dSc = 0;                        // dS_c/dρ of the pair's own gap
   Vec3 Hhat = Vec3::Zero();              // direction of H_app
   double Ms = 0;
   Mat3 Japp = Mat3::Zero();              // ∂H_app/∂x at the midpoint
@@ -229,6 +252,13 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   double dS_dg = 0;
   q.S = pair_switch(q.g, &dS_dg);
   q.dS = dS_dg / q.a;
+  // ν = 1 + (n_i + n_j)/2 − S_c(g): the other contacts of the pair's two balls
+  const double Sc = pair_count_switch(q.g, &dS_dg);
+  q.dSc = dS_dg / q.a;
+  const double nu = std::max(1.0, 1.0 + 0.5 * (ws.count[p.i] + ws.count[p.j]) - Sc);
+  q.w = dmath::pow(nu, -kPairShareCoupling);
+  q.dw = -kPairShareCoupling * q.w / nu;
+  const double sh = dmath::pow(nu, kPairShareWiden), dsh = kPairShareWiden * sh / nu;
   // H_app: the permanent moments' field and H0 at the midpoint
   q.mid = 0.5 * (set.position[p.i] + set.position[p.j]);
   Vec3 H = set.H0;
@@ -240,7 +270,7 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   q.Ms = 0.5 * (set.Ms[p.i] + set.Ms[p.j]);
   const double Hn = H.norm();
   if (Hn > 0) q.Hhat = H / Hn;
-  const PairCoupling c = tab.at(q.g, q.Ms > 0 ? Hn / q.Ms : 0.0);
+  const PairCoupling c = tab.at(q.g, q.Ms > 0 ? Hn / q.Ms : 0.0, sh);
   const double a3 = q.a * q.a * q.a;
   q.A = c.par / a3;
   q.B = c.perp / a3;
@@ -248,6 +278,8 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   q.dB = c.dperp / (a3 * q.a);
   q.hA = c.dpar_dh / a3;
   q.hB = c.dperp_dh / a3;
+  q.nA = c.dpar_ds * dsh / a3;
+  q.nB = c.dperp_ds * dsh / a3;
   return q;
 }
 
@@ -260,7 +292,7 @@ bool same_description(const MomentDesc& a, const MomentDesc& b) {
          a.H0 == b.H0;
 }
 
-// K = S ΔT(r) of every near pair, rebuilt only when the description or μr changed
+// K = S ν^−β ΔT(r) of every near pair, rebuilt only when the description or μr changed
 const std::vector<NearCoupling>& couplings_of(const MomentDesc& set, const NearFieldOptions& opt,
                                               NearFieldWorkspace* ws) {
   if (ws->cached && ws->key_mu_r == opt.mu_r && same_description(ws->key, set)) return ws->couplings;
@@ -269,7 +301,7 @@ const std::vector<NearCoupling>& couplings_of(const MomentDesc& set, const NearF
   ws->couplings.clear();
   for (const NearPair& p : ws->pairs) {
     const PairGeometry q = geometry(set, tab, *ws, p, false);
-    const Mat3 K = q.S * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
+    const Mat3 K = q.S * q.w * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
     ws->couplings.push_back({p.i, p.j, K});
   }
   ws->key = set;
@@ -295,7 +327,7 @@ void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFi
   }
 }
 
-// E_ij = −μ0 m_iᵀ K m_j,  K = S ΔT
+// E_ij = −μ0 m_iᵀ K m_j,  K = S ν^−β ΔT
 double near_field_energy(const MomentDesc& set, const Magnetization& mz,
                          const NearFieldOptions& opt, NearFieldWorkspace* ws) {
   if (opt.model != NearField::Pair) return 0.0;
@@ -305,22 +337,31 @@ double near_field_energy(const MomentDesc& set, const Magnetization& mz,
   return E;
 }
 
-// E = −μ0 S(g) W,  W = (A − B) P + B Q,  P = (m_i·r̂)(m_j·r̂),  Q = m_i·m_j,
-// A, B = Δt∥, Δt⊥ / a³ at G(g, h); r = p_i − p_j, ρ = |r|, h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
+// E = −μ0 S(g) w W,  w = ν^−β,  W = (A − B) P + B Q,  P = (m_i·r̂)(m_j·r̂),  Q = m_i·m_j,
+// A, B = Δt∥, Δt⊥ / a³ at G(g, h, ν); r = p_i − p_j, ρ = |r|, h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
 //   ∂W/∂r = [(∂A/∂ρ − ∂B/∂ρ) P + ∂B/∂ρ Q] r̂ + (A − B) ∇_r P,
 //   ∇_r P = [(m_j·r̂)(m_i − (m_i·r̂) r̂) + (m_i·r̂)(m_j − (m_j·r̂) r̂)]/ρ,
-//   ∇_x (S W) = S W_h J_app Ĥ / Ms,  W_h = (∂A/∂h − ∂B/∂h) P + ∂B/∂h Q  (J_app symmetric),
-//   F_i = μ0 [S ∂W/∂r + W dS/dρ r̂ + ½ ∇_x (S W)],  F_j = μ0 [−S ∂W/∂r − W dS/dρ r̂ + ½ ∇_x (S W)],
-//   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 S W_h/Ms J_k Ĥ,
-//                                           τ_k = μ0 S W_h/Ms m_k × h(x − p_k, Ĥ).
+//   ∇_x (S w W) = S w W_h J_app Ĥ / Ms,  W_h = (∂A/∂h − ∂B/∂h) P + ∂B/∂h Q  (J_app symmetric),
+//   F_i = μ0 w [S ∂W/∂r + W dS/dρ r̂] + ½ μ0 ∇_x (S w W),  F_j = −μ0 w [S ∂W/∂r + W dS/dρ r̂] + ½ μ0 ∇_x (S w W),
+//   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 S w W_h/Ms J_k Ĥ,
+//                                           τ_k = μ0 S w W_h/Ms m_k × h(x − p_k, Ĥ);
+// through ν_p = 1 + (n_i + n_j)/2 − S_c(g_p), with Λ_p = ∂(S w W)/∂ν = S (w' W + w W_ν) and
+// λ_b = ½ Σ_{p ∋ b} Λ_p: every near pair c = (k, l) (p's own gap cancels in ν_p) adds
+//   F_k = μ0 (λ_k + λ_l − Λ_c) (dS_c/dρ) r̂_c,  F_l = −F_k.
 void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
                            const NearFieldOptions& opt, NearFieldWorkspace* ws,
                            std::vector<Vec3>* F, std::vector<Vec3>* tau) {
   if (opt.model != NearField::Pair) return;
   couplings_of(set, opt, ws);  // the pair list of `set` (compute_fields has made it already)
   const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  for (const NearPair& p : ws->pairs) {
+  std::vector<double> Lam(ws->pairs.size(), 0.0), lam(set.size(), 0.0);
+  std::vector<Vec3> rhat(ws->pairs.size());
+  std::vector<double> dSc(ws->pairs.size(), 0.0);
+  for (std::size_t n = 0; n < ws->pairs.size(); ++n) {
+    const NearPair& p = ws->pairs[n];
     const PairGeometry q = geometry(set, tab, *ws, p, true);
+    rhat[n] = q.rhat;
+    dSc[n] = q.dSc;
     if (q.S == 0 && q.dS == 0) continue;
     const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
     const double ui = mi.dot(q.rhat), uj = mj.dot(q.rhat);
@@ -329,9 +370,13 @@ void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
     const Vec3 dP = (uj * (mi - ui * q.rhat) + ui * (mj - uj * q.rhat)) / q.rho;
     const Vec3 dW = ((q.dA - q.dB) * P + q.dB * Q) * q.rhat + (q.A - q.B) * dP;
     const double Wh = (q.hA - q.hB) * P + q.hB * Q;
-    const double kh = q.Ms > 0 ? q.S * Wh / q.Ms : 0.0;  // ∂(S W)/∂|H_app|
+    const double Wn = (q.nA - q.nB) * P + q.nB * Q;
+    Lam[n] = q.S * (q.dw * W + q.w * Wn);
+    lam[p.i] += 0.5 * Lam[n];
+    lam[p.j] += 0.5 * Lam[n];
+    const double kh = q.Ms > 0 ? q.S * q.w * Wh / q.Ms : 0.0;  // ∂(S w W)/∂|H_app|
     const Vec3 dx = kh * (q.Japp * q.Hhat);
-    const Vec3 radial = q.S * dW + W * q.dS * q.rhat;
+    const Vec3 radial = q.w * (q.S * dW + W * q.dS * q.rhat);
     (*F)[p.i] += kMu0 * (radial + 0.5 * dx);
     (*F)[p.j] += kMu0 * (-radial + 0.5 * dx);
     if (kh == 0) continue;
@@ -341,6 +386,13 @@ void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
       (*F)[k] -= kMu0 * kh * (dipole_jacobian(rk, mk) * q.Hhat);
       if (tau) (*tau)[k] += kMu0 * kh * mk.cross(dipole_field(rk, q.Hhat));
     }
+  }
+  for (std::size_t n = 0; n < ws->pairs.size(); ++n) {
+    if (dSc[n] == 0) continue;
+    const NearPair& p = ws->pairs[n];
+    const Vec3 f = kMu0 * (lam[p.i] + lam[p.j] - Lam[n]) * dSc[n] * rhat[n];
+    (*F)[p.i] += f;
+    (*F)[p.j] -= f;
   }
 }
 

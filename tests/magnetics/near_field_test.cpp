@@ -68,8 +68,9 @@ double minus_dU(const MomentSet& s, const FieldOptions& f, double d,
   return (4 * central(0.5 * d) - central(d)) / 3;
 }
 
-// A tilted pair at gap g (radii) and a bent chain of four with gaps g, 1.5g, g (its second
-// neighbours 1.5–1.6a apart at g ≤ 0.03, in the cut-off step), a magnet below them and H0 of h Ms. The
+// A tilted pair at gap g (radii) and a bent chain of four with gaps g, 1.5g, 0.7 (the last in
+// the contact count's step; the first two balls' second neighbour in the cut-off step), a magnet below them
+// and H0 of h Ms. The
 // magnet adds a fifth of h Ms at 25 mm, so H_app varies across the balls (its gradient is
 // what moves G on the magnet's and the balls' forces).
 MomentSet pair_and_chain(double g, double h) {
@@ -79,7 +80,7 @@ MomentSet pair_and_chain(double g, double h) {
   s.add_induced(pc - 0.5 * (2 + g) * a * axis, ball_volume(), kIronMs);
   s.add_induced(pc + 0.5 * (2 + g) * a * axis, ball_volume(), kIronMs);
   const Vec3 dirs[3] = {Vec3(1, 0, 0), Vec3(0.5, 0, 0.866025403784), Vec3(1, 0, 0.05).normalized()};
-  const double gaps[3] = {g, 1.5 * g, g};
+  const double gaps[3] = {g, 1.5 * g, 0.7};
   Vec3 p(0.006, -0.001, 0.002);
   s.add_induced(p, ball_volume(), kIronMs);
   for (int k = 0; k < 3; ++k) {
@@ -230,6 +231,20 @@ TEST_CASE("pair model: the coupling, switch and widened gap are smooth and as do
     CHECK(lo.par == Approx(hi.par).epsilon(1e-7));
     CHECK(lo.dpar_dh == Approx(hi.dpar_dh).epsilon(1e-6));
   }
+  // the contact count: 1 to g = 0.5, 0 from g = 1; a straight 3-chain counts 1, 2, 1
+  CHECK(pair_count_switch(0.5) == 1.0);
+  CHECK(pair_count_switch(1.0) == 0.0);
+  CHECK(pair_count_switch(0.75) == Approx(0.5));
+  {
+    MomentSet chain;
+    for (int k = 0; k < 3; ++k) chain.add_induced(Vec3(0, 0, k * 2.003 * kBallRadius), ball_volume(), kIronMs);
+    NearFieldWorkspace nws;
+    find_near_pairs(chain, &nws);
+    REQUIRE(nws.count.size() == 3);
+    CHECK(nws.count[0] == 1.0);
+    CHECK(nws.count[1] == 2.0);
+    CHECK(nws.count[2] == 1.0);
+  }
   // the axial coupling strengthens towards contact; an overlap reads as contact, g_m
   CHECK(tab.at(0.0).par > tab.at(0.1).par);
   CHECK(tab.at(-0.02).par > tab.at(0.0).par);
@@ -287,8 +302,8 @@ TEST_CASE("pair model: forces and the magnet's torque are -grad U* across the wi
       MomentSet s = pair_and_chain(g, h);
       NearFieldWorkspace nws;
       find_near_pairs(s, &nws);
-      // the pair, three contacts, and (below g = 0.3a) two second neighbours
-      REQUIRE(nws.pairs.size() == (g < 0.3 ? 6u : 4u));
+      // the pair, three contacts, and (below g = 0.3a) a second neighbour
+      REQUIRE(nws.pairs.size() == (g < 0.3 ? 5u : 4u));
       MomentSet solved = s;
       REQUIRE(solve_exact(&solved, Curve::Tanh, f, 1e-14, 100).residual < 1e-11);
       MagWorkspace mws;
