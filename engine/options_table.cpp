@@ -261,7 +261,8 @@ std::vector<OptionSpec> build() {
       named(MEMBER(magnetics.field.near_field.model), mag::NearField::Dipole, mag::kNearFieldNames,
             "near-field model",
             "near field of touching iron balls: dipole = one point dipole each; pair = exact two-sphere "
-            "couplings for pairs closer than a gap of 2 radii, faded as the contact saturates "
+            "couplings for pairs closer than a gap of 2 radii, at a wider gap as the contact saturates and "
+            "weaker where a chain's contacts share the flux "
             "(magnetics/near_field.hpp); pair needs the classic force")
           .was("near_field").flag("--near-field"),
       number(MEMBER(magnetics.field.near_field.mu_r), 1000.0, closed(10, 10000), "",

@@ -1,5 +1,5 @@
 // magnetics/near_field.cpp — the near-field pair model (near_field.hpp): the coupling table,
-// the fade, the pair list, and the model's field, energy and forces.
+// the widened gap, the pair list, and the model's field, energy and forces.
 #include "magnetics/near_field.hpp"
 #include "magnetics/det_math.hpp"
 
@@ -36,11 +36,22 @@ double table_step() {
   return (dmath::log(kTableGapMax) - dmath::log(kTableGapMin)) / (kTableNodes - 1);
 }
 
-// Value and derivative in x of the spline (y, m) at x = ln g_e.
+// Value and derivative in x of the spline (y, m) at x = ln G. Beyond the last node x_n:
+// v = v_n e^{λ(x − x_n)}, λ = v'_n / v_n (a power law in G, C¹ at x_n: the table's corrections
+// fall as G^−6 there); held at v_n if the end did not fall.
 void spline_eval(const std::vector<double>& y, const std::vector<double>& m, double x,
                  double* v, double* dv) {
   const double h = table_step();
   const double x0 = dmath::log(kTableGapMin);
+  const double xn = dmath::log(kTableGapMax);
+  if (x > xn) {
+    double vn = 0, dvn = 0;
+    spline_eval(y, m, xn, &vn, &dvn);
+    const double lam = (vn != 0 && dvn / vn < 0) ? dvn / vn : 0.0;
+    *v = vn * dmath::exp(lam * (x - xn));
+    *dv = lam * *v;
+    return;
+  }
   double s = (x - x0) / h;
   int k = static_cast<int>(std::floor(s));
   k = std::clamp(k, 0, kTableNodes - 2);
@@ -84,24 +95,41 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
   perp2_ = spline_second(perp_, table_step());
 }
 
-// Δt(g) = spline(ln g_e(g)); dΔt/dg = spline'(x) · (1/g_e) · dg_e/dg
-PairCoupling PairCouplingTable::at(double g) const {
+// G = g_e(g) + s κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = s κ q h^{q−1}
+double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh, double s) {
   double dge = 0;
   const double ge = pair_effective_gap(g, &dge);
-  const double x = dmath::log(ge), dx = dge / ge;
+  const double w = h > 0 ? s * kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  if (dG_dg) *dG_dg = dge;
+  if (dG_dh) *dG_dh = h > 0 ? kPairWidenPower * w / h : 0.0;
+  return ge + w;
+}
+
+// Δt(g, h, s) = spline(ln G(g, h, s)); ∂Δt/∂g = spline'(x) (∂G/∂g)/G, and so for h and s
+// (∂G/∂s = κ h^q)
+PairCoupling PairCouplingTable::at(double g, double h, double s) const {
+  double dGg = 0, dGh = 0;
+  const double G = pair_widened_gap(g, h, &dGg, &dGh, s);
+  const double dGs = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
   spline_eval(par_, par2_, x, &c.par, &d);
-  c.dpar = d * dx;
+  c.dpar = d * dGg / G;
+  c.dpar_dh = d * dGh / G;
+  c.dpar_ds = d * dGs / G;
   spline_eval(perp_, perp2_, x, &c.perp, &d);
-  c.dperp = d * dx;
+  c.dperp = d * dGg / G;
+  c.dperp_dh = d * dGh / G;
+  c.dperp_ds = d * dGs / G;
   return c;
 }
 
-// S(g) = 1 − (10 s³ − 15 s⁴ + 6 s⁵), s = (g − g_full)/(g_cut − g_full) ∈ [0, 1]
-double pair_switch(double g, double* dS_dg) {
-  const double w = kPairCutoffGap - kPairFullGap;
-  const double s = (g - kPairFullGap) / w;
+namespace {
+// 1 − (10 s³ − 15 s⁴ + 6 s⁵), s = (g − g_full)/(g_cut − g_full) ∈ [0, 1]
+double quintic_step(double g, double g_full, double g_cut, double* dS_dg) {
+  const double w = g_cut - g_full;
+  const double s = (g - g_full) / w;
   if (s <= 0) {
     if (dS_dg) *dS_dg = 0;
     return 1.0;
@@ -113,17 +141,12 @@ double pair_switch(double g, double* dS_dg) {
   if (dS_dg) *dS_dg = -30.0 * s * s * (1.0 - s) * (1.0 - s) / w;
   return 1.0 - s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
 }
+}  // namespace
 
-// φ = 1/(1 + z), z = (h/h0)^p, h0 = h0* at every gap: c Δt must fall with the gap for the
-// correction to attract, and a fade that sets in later at wider gaps (h0 growing faster than
-// g^0.15 near contact) makes it repel — against the finite-element data's sign
-PairFade pair_fade(double h) {
-  PairFade f;
-  if (h <= 0) return f;
-  const double z = dmath::pow(h / kPairFadeField, kPairFadePower);
-  f.phi = 1.0 / (1.0 + z);
-  f.dphi_dh = -f.phi * f.phi * kPairFadePower * z / h;
-  return f;
+double pair_switch(double g, double* dS_dg) { return quintic_step(g, kPairFullGap, kPairCutoffGap, dS_dg); }
+
+double pair_count_switch(double g, double* dS_dg) {
+  return quintic_step(g, kPairCountFullGap, kPairCountCutoffGap, dS_dg);
 }
 
 const PairCouplingTable& NearFieldWorkspace::table_for(double mu_r) {
@@ -191,6 +214,14 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   }
   std::sort(ws->pairs.begin(), ws->pairs.end(),
             [](const NearPair& p, const NearPair& q) { return p.i != q.i ? p.i < q.i : p.j < q.j; });
+  // n_i = Σ_k S_c(g_ik): every contact is a near pair (kPairCountCutoffGap < kPairCutoffGap)
+  ws->count.assign(n, 0.0);
+  for (const NearPair& p : ws->pairs) {
+    const double g = (set.position[p.i] - set.position[p.j]).norm() / ws->a[p.i] - 2.0;
+    const double c = pair_count_switch(g);
+    ws->count[p.i] += c;
+    ws->count[p.j] += c;
+  }
 }
 
 namespace {
@@ -198,9 +229,12 @@ namespace {
 struct PairGeometry {
   Vec3 rhat;
   double rho = 0, a = 0, g = 0;
-  double A = 0, B = 0, dA = 0, dB = 0;  // Δt∥/a³, Δt⊥/a³ and d/dρ
+  double A = 0, B = 0, dA = 0, dB = 0;  // Δt∥/a³, Δt⊥/a³ at G and d/dρ
+  double hA = 0, hB = 0;                 // ∂A/∂h, ∂B/∂h
+  double nA = 0, nB = 0;                 // ∂A/∂ν, ∂B/∂ν
   double S = 0, dS = 0;                  // switch and dS/dρ
-  PairFade fade;                         // φ, ∂φ/∂h
+  double w = 1, dw = 0;                  // ν^−β and d/dν
+  double dSc = 0;                        // dS_c/dρ of the pair's own gap
   Vec3 Hhat = Vec3::Zero();              // direction of H_app
   double Ms = 0;
   Mat3 Japp = Mat3::Zero();              // ∂H_app/∂x at the midpoint
@@ -218,12 +252,13 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   double dS_dg = 0;
   q.S = pair_switch(q.g, &dS_dg);
   q.dS = dS_dg / q.a;
-  const PairCoupling c = tab.at(q.g);
-  const double a3 = q.a * q.a * q.a;
-  q.A = c.par / a3;
-  q.B = c.perp / a3;
-  q.dA = c.dpar / (a3 * q.a);
-  q.dB = c.dperp / (a3 * q.a);
+  // ν = 1 + (n_i + n_j)/2 − S_c(g): the other contacts of the pair's two balls
+  const double Sc = pair_count_switch(q.g, &dS_dg);
+  q.dSc = dS_dg / q.a;
+  const double nu = std::max(1.0, 1.0 + 0.5 * (ws.count[p.i] + ws.count[p.j]) - Sc);
+  q.w = dmath::pow(nu, -kPairShareCoupling);
+  q.dw = -kPairShareCoupling * q.w / nu;
+  const double sh = dmath::pow(nu, kPairShareWiden), dsh = kPairShareWiden * sh / nu;
   // H_app: the permanent moments' field and H0 at the midpoint
   q.mid = 0.5 * (set.position[p.i] + set.position[p.j]);
   Vec3 H = set.H0;
@@ -235,7 +270,16 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   q.Ms = 0.5 * (set.Ms[p.i] + set.Ms[p.j]);
   const double Hn = H.norm();
   if (Hn > 0) q.Hhat = H / Hn;
-  q.fade = pair_fade(q.Ms > 0 ? Hn / q.Ms : 0.0);
+  const PairCoupling c = tab.at(q.g, q.Ms > 0 ? Hn / q.Ms : 0.0, sh);
+  const double a3 = q.a * q.a * q.a;
+  q.A = c.par / a3;
+  q.B = c.perp / a3;
+  q.dA = c.dpar / (a3 * q.a);
+  q.dB = c.dperp / (a3 * q.a);
+  q.hA = c.dpar_dh / a3;
+  q.hB = c.dperp_dh / a3;
+  q.nA = c.dpar_ds * dsh / a3;
+  q.nB = c.dperp_ds * dsh / a3;
   return q;
 }
 
@@ -248,7 +292,7 @@ bool same_description(const MomentDesc& a, const MomentDesc& b) {
          a.H0 == b.H0;
 }
 
-// K = c ΔT(r) of every near pair, rebuilt only when the description or μr changed
+// K = S ν^−β ΔT(r) of every near pair, rebuilt only when the description or μr changed
 const std::vector<NearCoupling>& couplings_of(const MomentDesc& set, const NearFieldOptions& opt,
                                               NearFieldWorkspace* ws) {
   if (ws->cached && ws->key_mu_r == opt.mu_r && same_description(ws->key, set)) return ws->couplings;
@@ -257,8 +301,7 @@ const std::vector<NearCoupling>& couplings_of(const MomentDesc& set, const NearF
   ws->couplings.clear();
   for (const NearPair& p : ws->pairs) {
     const PairGeometry q = geometry(set, tab, *ws, p, false);
-    const double c = q.S * q.fade.phi;
-    const Mat3 K = c * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
+    const Mat3 K = q.S * q.w * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
     ws->couplings.push_back({p.i, p.j, K});
   }
   ws->key = set;
@@ -284,7 +327,7 @@ void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFi
   }
 }
 
-// E_ij = −μ0 m_iᵀ K m_j,  K = c ΔT
+// E_ij = −μ0 m_iᵀ K m_j,  K = S ν^−β ΔT
 double near_field_energy(const MomentDesc& set, const Magnetization& mz,
                          const NearFieldOptions& opt, NearFieldWorkspace* ws) {
   if (opt.model != NearField::Pair) return 0.0;
@@ -294,42 +337,62 @@ double near_field_energy(const MomentDesc& set, const Magnetization& mz,
   return E;
 }
 
-// With r = p_i − p_j, ρ = |r|, c = S(g) φ(h), h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
-//   ∂W/∂r = [(A' − B') P + B' Q] r̂ + (A − B) ∇_r P,
+// E = −μ0 S(g) w W,  w = ν^−β,  W = (A − B) P + B Q,  P = (m_i·r̂)(m_j·r̂),  Q = m_i·m_j,
+// A, B = Δt∥, Δt⊥ / a³ at G(g, h, ν); r = p_i − p_j, ρ = |r|, h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
+//   ∂W/∂r = [(∂A/∂ρ − ∂B/∂ρ) P + ∂B/∂ρ Q] r̂ + (A − B) ∇_r P,
 //   ∇_r P = [(m_j·r̂)(m_i − (m_i·r̂) r̂) + (m_i·r̂)(m_j − (m_j·r̂) r̂)]/ρ,
-//   ∂c/∂ρ = (dS/dρ) φ,   ∇_x c = S (∂φ/∂h) J_app Ĥ / Ms   (J_app symmetric),
-//   F_i = μ0 [c ∂W/∂r + W (∂c/∂ρ r̂ + ½ ∇_x c)],  F_j = μ0 [−c ∂W/∂r − W ∂c/∂ρ r̂ + ½ W ∇_x c],
-//   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 W S (∂φ/∂h)/Ms J_k Ĥ,
-//                                           τ_k = μ0 W S (∂φ/∂h)/Ms m_k × h(x − p_k, Ĥ).
+//   ∇_x (S w W) = S w W_h J_app Ĥ / Ms,  W_h = (∂A/∂h − ∂B/∂h) P + ∂B/∂h Q  (J_app symmetric),
+//   F_i = μ0 w [S ∂W/∂r + W dS/dρ r̂] + ½ μ0 ∇_x (S w W),  F_j = −μ0 w [S ∂W/∂r + W dS/dρ r̂] + ½ μ0 ∇_x (S w W),
+//   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 S w W_h/Ms J_k Ĥ,
+//                                           τ_k = μ0 S w W_h/Ms m_k × h(x − p_k, Ĥ);
+// through ν_p = 1 + (n_i + n_j)/2 − S_c(g_p), with Λ_p = ∂(S w W)/∂ν = S (w' W + w W_ν) and
+// λ_b = ½ Σ_{p ∋ b} Λ_p: every near pair c = (k, l) (p's own gap cancels in ν_p) adds
+//   F_k = μ0 (λ_k + λ_l − Λ_c) (dS_c/dρ) r̂_c,  F_l = −F_k.
 void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
                            const NearFieldOptions& opt, NearFieldWorkspace* ws,
                            std::vector<Vec3>* F, std::vector<Vec3>* tau) {
   if (opt.model != NearField::Pair) return;
   couplings_of(set, opt, ws);  // the pair list of `set` (compute_fields has made it already)
   const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  for (const NearPair& p : ws->pairs) {
+  std::vector<double> Lam(ws->pairs.size(), 0.0), lam(set.size(), 0.0);
+  std::vector<Vec3> rhat(ws->pairs.size());
+  std::vector<double> dSc(ws->pairs.size(), 0.0);
+  for (std::size_t n = 0; n < ws->pairs.size(); ++n) {
+    const NearPair& p = ws->pairs[n];
     const PairGeometry q = geometry(set, tab, *ws, p, true);
-    const double c = q.S * q.fade.phi;
-    const double dc = q.dS * q.fade.phi;
-    if (c == 0 && dc == 0) continue;
+    rhat[n] = q.rhat;
+    dSc[n] = q.dSc;
+    if (q.S == 0 && q.dS == 0) continue;
     const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
     const double ui = mi.dot(q.rhat), uj = mj.dot(q.rhat);
     const double P = ui * uj, Q = mi.dot(mj);
     const double W = (q.A - q.B) * P + q.B * Q;
     const Vec3 dP = (uj * (mi - ui * q.rhat) + ui * (mj - uj * q.rhat)) / q.rho;
     const Vec3 dW = ((q.dA - q.dB) * P + q.dB * Q) * q.rhat + (q.A - q.B) * dP;
-    const double kh = q.Ms > 0 ? q.S * q.fade.dphi_dh / q.Ms : 0.0;  // ∂c/∂|H_app|
-    const Vec3 dcx = kh * (q.Japp * q.Hhat);
-    const Vec3 radial = c * dW + W * dc * q.rhat;
-    (*F)[p.i] += kMu0 * (radial + 0.5 * W * dcx);
-    (*F)[p.j] += kMu0 * (-radial + 0.5 * W * dcx);
+    const double Wh = (q.hA - q.hB) * P + q.hB * Q;
+    const double Wn = (q.nA - q.nB) * P + q.nB * Q;
+    Lam[n] = q.S * (q.dw * W + q.w * Wn);
+    lam[p.i] += 0.5 * Lam[n];
+    lam[p.j] += 0.5 * Lam[n];
+    const double kh = q.Ms > 0 ? q.S * q.w * Wh / q.Ms : 0.0;  // ∂(S w W)/∂|H_app|
+    const Vec3 dx = kh * (q.Japp * q.Hhat);
+    const Vec3 radial = q.w * (q.S * dW + W * q.dS * q.rhat);
+    (*F)[p.i] += kMu0 * (radial + 0.5 * dx);
+    (*F)[p.j] += kMu0 * (-radial + 0.5 * dx);
     if (kh == 0) continue;
     for (const int k : ws->perm) {
       const Vec3& mk = set.m_perm[k];
       const Vec3 rk = q.mid - set.position[k];
-      (*F)[k] -= kMu0 * W * kh * (dipole_jacobian(rk, mk) * q.Hhat);
-      if (tau) (*tau)[k] += kMu0 * W * kh * mk.cross(dipole_field(rk, q.Hhat));
+      (*F)[k] -= kMu0 * kh * (dipole_jacobian(rk, mk) * q.Hhat);
+      if (tau) (*tau)[k] += kMu0 * kh * mk.cross(dipole_field(rk, q.Hhat));
     }
+  }
+  for (std::size_t n = 0; n < ws->pairs.size(); ++n) {
+    if (dSc[n] == 0) continue;
+    const NearPair& p = ws->pairs[n];
+    const Vec3 f = kMu0 * (lam[p.i] + lam[p.j] - Lam[n]) * dSc[n] * rhat[n];
+    (*F)[p.i] += f;
+    (*F)[p.j] -= f;
   }
 }
 

@@ -1,14 +1,15 @@
 // magnetics/near_field.hpp — the near-field pair model: two touching iron spheres coupled as
-// exact linear magnetostatics says, not as two point dipoles, faded as the contact saturates.
+// exact linear magnetostatics says, not as two point dipoles, at a wider gap as the contact
+// saturates.
 //
 // One point dipole per ball is weakest where balls touch: in an axial field the dipole pair
 // attracts 2.8× too weakly at g = 0.1a and 36× at 0.003a (μr = 1000), and in a transverse
 // field it repels up to 42 % too strongly (magnetics/PHYSICS.md, "The near field"). The pair
 // model adds to every pair of induced spheres closer than kPairCutoffGap the energy
-//   E_ij = −μ0 c_ij m_iᵀ ΔT(r_ij) m_j,
-//   ΔT(r) = [Δt∥(g) r̂ r̂ᵀ + Δt⊥(g) (I − r̂ r̂ᵀ)] / a³,   c = S(g) φ(h),
+//   E_ij = −μ0 S(g) ν^−β m_iᵀ ΔT(r_ij) m_j,
+//   ΔT(r) = [Δt∥(G) r̂ r̂ᵀ + Δt⊥(G) (I − r̂ r̂ᵀ)] / a³,   G = g_e(g) + κ ν^γ h^q,
 // in the co-energy's pair sum (coenergy.hpp), so that the field a ball feels from its partner
-// is (T + c ΔT) m_j and every force stays −∇U*:
+// is (T + S ν^−β ΔT) m_j and every force stays −∇U*:
 //   * Δt∥, Δt⊥: the exact two-sphere coupling corrections (tools/reference/
 //     near_field_table.py) that make the pair's linear polarizability C∥(d), C⊥(d) exact for
 //     the material's initial μr, so that two balls in a weak uniform field feel the exact
@@ -19,13 +20,22 @@
 //     made steps that the contact solver and the pull trade energy in (the energy guard's
 //     retakes could not resolve them at g_m = 1e-4, g_s = 2.5e-4);
 //   * S(g): 1 for g ≤ kPairFullGap, a quintic step to 0 at kPairCutoffGap (C² throughout);
-//   * φ(h) = 1/(1 + (h/h0)^p), h = |H_app|/Ms at the pair's midpoint, H_app the field of
-//     the permanent moments and H0 (not of the induced ones: φ must not depend on M, or the
-//     magnetization equation would change): the saturation of the contact region. h0 and p
-//     are fitted to a nonlinear finite-element solution (axial, g = 0.003a, μr = 1000, tanh
-//     curve) across H0/Ms = 1e-4…10 (tools/findings/near_field.md). h0 is the same at every
-//     gap: for the correction to attract, c Δt must fall as the gap opens, and an h0 that
-//     grows faster than about g^0.15 near contact would make the pair repel.
+//   * G: the saturated contact read as a wider gap (PHYSICS.md, "The near field"). Where the
+//     linear gap field would exceed Ms the iron cannot carry the flux and acts as air, so the
+//     correction is the exact linear one at G = g_e + κ h^q (ν = 1), h = |H_app|/Ms at the pair's
+//     midpoint, H_app the field of the permanent moments and H0 (not of the induced ones: G
+//     must not depend on M, or the magnetization equation would change). κ and q are fitted
+//     to the nonlinear finite-element table (tools/findings/near_field_reference.md). At low
+//     field G = g_e and the pair is exact linear; dG/dg = dg_e/dg > 0 and Δt falls with the
+//     gap, so the correction always attracts;
+//   * ν: the contacts the pair shares its balls' flux with, ν = 1 + (n_i + n_j)/2 − S_c(g),
+//     n_i = Σ_k S_c(g_ik) the smooth contact count of ball i (S_c: 1 up to kPairCountFullGap,
+//     a quintic step to 0 at kPairCountCutoffGap). ν = 1 for a lone pair, 1.5 for a chain's
+//     end contact, 2 inside a chain: in a chain of high-μ iron the contacts share the flux,
+//     so each couples less (ν^−β) and saturates earlier (ν^γ) than a lone pair. β and γ are
+//     fitted to the finite-element 3-chains (tools/findings/near_field_reference.md) and
+//     checked on its 5-chains. ν depends on positions only, so the forces
+//     carry its gap derivatives: every contact of either ball moves the pair's energy.
 // Eligible: induced moments that are the only moment of their body (group −1 or a group of
 // one), with a radius equal to the sphere of their volume, a = (3V/4π)^{1/3} (or no radius
 // set), pairs of equal radii. Every other pair keeps the dipole interaction.
@@ -62,44 +72,54 @@ inline constexpr double kPairFullGap = 1.0;       ///< S = 1 up to this gap
 inline constexpr double kPairCutoffGap = 2.0;     ///< S = 0 from this gap on: pure dipoles
 inline constexpr double kPairContactGap = 1.5e-3; ///< g_m: what contact reads as, 7.5 µm at a = 5 mm
 inline constexpr double kPairSmoothGap = 5e-4;    ///< g_s: the width of the step to g_m
-inline constexpr double kPairFadeField = 0.0138;  ///< h0 (|H_app|/Ms)
-inline constexpr double kPairFadePower = 1.2;     ///< p (h0 and p fitted at a gap of 0.003a)
+inline constexpr double kPairWidenScale = 0.553;  ///< κ (gap widening per h^q, radii)
+inline constexpr double kPairWidenPower = 1.22;   ///< q (κ and q fitted to the FEM table)
+inline constexpr double kPairCountFullGap = 0.5;  ///< S_c = 1 up to this gap
+inline constexpr double kPairCountCutoffGap = 1.0; ///< S_c = 0 from this gap on
+inline constexpr double kPairShareCoupling = 0.4;  ///< β: the coupling ν^−β
+inline constexpr double kPairShareWiden = 1.0;     ///< γ: the widening κ ν^γ h^q
 
 /// g_e of a gap g and dg_e/dg.
 double pair_effective_gap(double g, double* dge_dg = nullptr);
 
-/// Δt∥ a³, Δt⊥ a³ and their derivatives in g, for relative permeability mu_r at gap g (both
-/// in radii; g > −2). Interpolated: natural cubic splines in ln g_e through the table's
-/// nodes, linear in ln μr between its rows.
+/// The widened gap G = g_e(g) + s κ h^q (radii) of a gap g at h = |H_app|/Ms ≥ 0 and a
+/// sharing factor s (ν^γ; 1 for a lone pair), with dG/dg and dG/dh.
+double pair_widened_gap(double g, double h, double* dG_dg = nullptr, double* dG_dh = nullptr,
+                        double s = 1.0);
+
+/// Δt∥ a³, Δt⊥ a³ at the widened gap G(g, h, s) and their derivatives, for relative
+/// permeability mu_r (g in radii, g > −2; h = |H_app|/Ms ≥ 0, 0 = the linear limit).
+/// Interpolated: natural cubic splines in ln G through the table's nodes, linear in ln μr
+/// between its rows; beyond the last node (G > 2.2, wide or saturated) a power tail in G
+/// that continues the spline's value and slope.
 struct PairCoupling {
-  double par = 0, perp = 0;    ///< Δt∥ a³, Δt⊥ a³
-  double dpar = 0, dperp = 0;  ///< their derivatives in g
+  double par = 0, perp = 0;        ///< Δt∥ a³, Δt⊥ a³
+  double dpar = 0, dperp = 0;      ///< their derivatives in g
+  double dpar_dh = 0, dperp_dh = 0;  ///< their derivatives in h
+  double dpar_ds = 0, dperp_ds = 0;  ///< their derivatives in s
 };
 class PairCouplingTable {
  public:
   explicit PairCouplingTable(double mu_r);
   double mu_r() const { return mu_r_; }
-  PairCoupling at(double g) const;
+  PairCoupling at(double g, double h = 0.0, double s = 1.0) const;
 
  private:
   double mu_r_;
   std::vector<double> par_, perp_, par2_, perp2_;  // node values and spline second derivatives
 };
 
-/// The saturation fade φ(h) and dφ/dh (the same at every gap).
-struct PairFade {
-  double phi = 1, dphi_dh = 0;
-};
-PairFade pair_fade(double h);
 /// The cut-off step S(g) and dS/dg.
 double pair_switch(double g, double* dS_dg = nullptr);
+/// The contact count's step S_c(g) and dS_c/dg.
+double pair_count_switch(double g, double* dS_dg = nullptr);
 
 /// A pair of eligible moments closer than the cut-off (i < j).
 struct NearPair {
   int i, j;
 };
 /// The pair model's coupling of one near pair: the field at i is K m_j and at j is K m_i,
-/// K = c ΔT(r_ij) (symmetric, even in r; 1/m³).
+/// K = S ν^−β ΔT(r_ij) (symmetric, even in r; 1/m³).
 struct NearCoupling {
   int i, j;
   Mat3 K;
@@ -114,6 +134,7 @@ struct NearFieldWorkspace {
   double key_mu_r = 0;
   bool cached = false;
   std::vector<double> a;  ///< (n) sphere radius of each eligible moment, 0 = not eligible
+  std::vector<double> count;  ///< (n) contact count n_i of `pairs`
   std::vector<int> perm;  ///< the permanent moments (the sources of H_app)
   std::vector<std::pair<long long, int>> cells;  ///< scratch: (grid cell, moment)
   std::vector<PairCouplingTable> table;          ///< 0 or 1 entry
@@ -129,7 +150,7 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws);
 void near_field_couplings(const MomentDesc& set, const NearFieldOptions& opt,
                           NearFieldWorkspace* ws, std::vector<NearCoupling>* out);
 
-/// Adds the pair model's field c ΔT(r_ij) m_j to H_i and c ΔT m_i to H_j of every near pair
+/// Adds the pair model's field K m_j to H_i and K m_i to H_j of every near pair
 /// (the field −(1/μ0) ∂E/∂m the magnetization feels). No-op for NearField::Dipole.
 void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
                     NearFieldWorkspace* ws, std::vector<Vec3>* H);
