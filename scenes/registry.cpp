@@ -109,6 +109,7 @@ Quat axis_angle(double angle, const Vec3& axis) {
 SceneDesc balls_up(const SceneParams& p) {
   SceneDesc s;
   s.name = "balls_up";
+  s.options.sleep = true;  // resting islands leave the step (engine/sleep.cpp)
   s.description = "243 iron balls on frictionless ground pulled up by a fixed cube magnet";
   s.modelling_level =
       "1 induced moment per ball (sphere primitive); magnet: static box geom with 1 "
@@ -200,6 +201,7 @@ BodyDesc letter(int index, const Vec3& p, const Quat& q) {
 SceneDesc alphabets(const SceneParams& p) {
   SceneDesc s;
   s.name = "alphabets";
+  s.options.sleep = true;  // resting islands leave the step (engine/sleep.cpp)
   s.description = "100 iron letters in mid-air gathered by an invisible, excessively strong moment";
   s.modelling_level =
       "letters = 1–4 boxes, 1 induced moment per box; central moment: static, invisible, "
@@ -246,6 +248,7 @@ SceneDesc alphabets(const SceneParams& p) {
 SceneDesc falling_magnet(const SceneParams& p) {
   SceneDesc s;
   s.name = "falling_magnet";
+  s.options.sleep = true;  // resting islands leave the step (engine/sleep.cpp)
   s.description = "a heavy sphere magnet falls onto 1032 stacked iron balls";
   s.modelling_level =
       "1 induced moment per ball; magnet: dynamic sphere with 1 permanent moment (torque on "
@@ -296,6 +299,7 @@ SceneDesc falling_magnet(const SceneParams& p) {
 SceneDesc sakura_tree(const SceneParams& p) {
   SceneDesc s;
   s.name = "sakura_tree";
+  s.options.sleep = true;  // resting islands leave the step (engine/sleep.cpp)
   s.description = "2500 iron balls fall onto a tree whose branch ends are magnets";
   s.modelling_level =
       "1 induced moment per ball; tree: static capsules (trunk, 2 levels of branches); 8 "
