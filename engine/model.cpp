@@ -81,8 +81,6 @@ void check_options(const SimOptions& o, const Vec3& H0) {
   if (o.balance_magnetic_torque && !o.reaction_symmetric_forces)
     fail("options.balance_magnetic_torque",
          "needs reaction_symmetric_forces (it removes the torque those forces leave)");
-  if (o.sleep && o.auto_disable)
-    fail("options.sleep", "and auto_disable both put bodies to sleep: choose one (sleep knows the magnetics)");
   if (o.sleep && o.magnetics.method == mag::Method::Exact)
     fail("options.sleep", "needs a relaxation method: exact re-solves every moment, a sleeping one too");
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
@@ -260,6 +258,7 @@ Model compile_model(const SceneDesc& scene) {
 
   Model m;
   m.options = scene.options;
+  if (m.options.auto_disable) m.options.sleep = false;  // ODE's own sleep was asked for: it alone
   m.resolved = resolve(scene.options);
   m.H0 = scene.H0;
   if (const std::string e = camera_error(scene.camera); !e.empty()) fail("camera", e);

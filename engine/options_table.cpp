@@ -340,7 +340,7 @@ std::vector<OptionSpec> build() {
       boolean(MEMBER(sleep), false,
               "sleeping islands: bodies joined by contacts that have all been still (sleep_speed) for sleep_time "
               "leave the rigid step, their moments stay field sources with M frozen; woken by a touch, by a "
-              "change of the field at a moment beyond sleep_field_tolerance, or by the user")
+              "change of the field at a moment beyond sleep_field_tolerance, or by the user (off under auto_disable)")
           .flag("--sleep"),
       number(MEMBER(sleep_speed), 0.02, above(0), "m/s",
              "a body is still while its mean velocities over the last sleep_time/2 give |v| + |omega| r_body "

@@ -6,8 +6,10 @@
 // give |v̄| + |ω̄| r_b < sleep_speed (r_b the bounding radius; ω̄ is left out for a body whose
 // turning changes nothing the model sees: spheres and induced moments at its centre). A pile's
 // contacts make bodies jitter fast in place; their mean velocity is the creep a viewer sees.
-// An island falls asleep when every body in it has been still for sleep_time, 1 + one in 100
-// of them allowed to rattle in place at up to 5 × sleep_speed (kRattle below). Asleep:
+// An island falls asleep when it rests on the world (one of its bodies touches the ground, a
+// static or a kinematic body: a body slow at the top of its flight, or starting from rest,
+// is not at rest) and every body in it has been still for sleep_time, one in 100 of them
+// allowed to rattle in place at up to 5 × sleep_speed (kRattle below). Asleep:
 //   - its bodies are disabled in ODE (no step, no gravity, no contact rows) with v = ω = 0;
 //   - its moments stay field sources, their magnetization frozen (MomentDesc::frozen): the
 //     relaxation leaves them as they are, so a sleeping island's own field never changes;
@@ -34,7 +36,7 @@ namespace {
 
 // A pile's rattlers: bodies squeezed by the field that the contact solver never quite settles
 // jitter in place with mean speeds of a few sleep_speeds (falling_magnet: up to 4 × 0.02 m/s
-// while the rest creeps below 0.02). An island may hold 1 + one in kRattlersPer, each below
+// while the rest creeps below 0.02). An island may hold one in kRattlersPer, each below
 // kRattle × sleep_speed; they sleep with it.
 constexpr double kRattle = 5.0;
 constexpr int kRattlersPer = 100;
@@ -182,8 +184,9 @@ void settle(const Model& m, State* next, std::vector<int>* fell_asleep) {
     const int ra = find(parent, a), rb = find(parent, b);
     if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);  // the root: the lowest index
   }
-  // an island is restless while a body has not been still for sleep_time, or while more than
-  // 1 + one in kRattlersPer of its bodies rattle (still, but not quiet)
+  // an island is restless while a body has not been still for sleep_time, while more than one
+  // in kRattlersPer of its bodies rattle (still, but not quiet), or while it touches no body
+  // of the world
   std::vector<std::uint8_t> restless(m.nbody, 0);
   std::vector<int> size(m.nbody, 0), rattlers(m.nbody, 0);
   for (int b : m.dynamic_bodies) {
@@ -193,8 +196,15 @@ void settle(const Model& m, State* next, std::vector<int>* fell_asleep) {
     if (!quiet[b]) ++rattlers[r];
     if (next->still_time[b] < o.sleep_time) restless[r] = 1;
   }
+  std::vector<std::uint8_t> supported(m.nbody, 0);
+  auto world = [&](int b) { return b < 0 || m.body_type[b] != BodyType::Dynamic; };
+  for (const auto& [a, b] : next->contact_pairs) {
+    if (world(a) && joins(b)) supported[find(parent, b)] = 1;
+    if (world(b) && joins(a)) supported[find(parent, a)] = 1;
+  }
   for (int b : m.dynamic_bodies)
-    if (!asleep(*next, b) && find(parent, b) == b && rattlers[b] > 1 + size[b] / kRattlersPer) restless[b] = 1;
+    if (!asleep(*next, b) && find(parent, b) == b && (rattlers[b] > size[b] / kRattlersPer || !supported[b]))
+      restless[b] = 1;
   for (int b : m.dynamic_bodies) {
     if (asleep(*next, b) || restless[find(parent, b)]) continue;
     fell_asleep->push_back(b);
