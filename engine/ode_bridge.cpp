@@ -335,7 +335,8 @@ struct OdeBridge::Impl {
     return mu * (z + std::sqrt(1.0 - z * z));
   }
 
-  int collide(std::vector<std::pair<int, int>>* pairs, double dt, double dt_soft, double* max_depth) {
+  int collide(std::vector<std::pair<int, int>>* pairs, double dt, double dt_soft, double* max_depth,
+              std::vector<std::pair<int, int>>* joined) {
     ensure_thread_data();
     recs.clear();
     dSpaceCollide(space, this, &near_callback);
@@ -351,6 +352,7 @@ struct OdeBridge::Impl {
     }
     std::sort(order.begin(), order.end());
     pairs->clear();
+    if (joined) joined->clear();
     const double touch = 0.1 * margin;  // gaps below this count as touching (metrics)
     // The contacts' softness for a step of dt: the spring and damper that ERP and CFM make at
     // the step dt_soft (kp = ERP/(CFM dt_soft), kd = (1 − ERP)/CFM), kept at dt:
@@ -397,6 +399,7 @@ struct OdeBridge::Impl {
       }
       dJointID j = dJointCreateContact(world, contact_group, &c);
       dJointAttach(j, dGeomGetBody(r.g.g1), dGeomGetBody(r.g.g2));
+      if (joined) joined->emplace_back(std::min(tag[r.a].body, tag[r.b].body), std::max(tag[r.a].body, tag[r.b].body));
       if (d > -touch) {
         const int ba = tag[r.a].body, bb = tag[r.b].body;
         pairs->emplace_back(std::min(ba, bb), std::max(ba, bb));
@@ -404,6 +407,10 @@ struct OdeBridge::Impl {
     }
     std::sort(pairs->begin(), pairs->end());
     pairs->erase(std::unique(pairs->begin(), pairs->end()), pairs->end());
+    if (joined) {
+      std::sort(joined->begin(), joined->end());
+      joined->erase(std::unique(joined->begin(), joined->end()), joined->end());
+    }
     if (max_depth) *max_depth = deepest;
     return static_cast<int>(recs.size());
   }
@@ -495,8 +502,8 @@ void OdeBridge::set_velocity(int i, const Vec3& v) {
 }
 
 int OdeBridge::collide(std::vector<std::pair<int, int>>* pairs, double h, double h_soft,
-                       double* max_depth) {
-  return impl_->collide(pairs, h, h_soft > 0 ? h_soft : h, max_depth);
+                       double* max_depth, std::vector<std::pair<int, int>>* joined) {
+  return impl_->collide(pairs, h, h_soft > 0 ? h_soft : h, max_depth, joined);
 }
 
 void OdeBridge::quickstep(unsigned long seed, double h) {

@@ -156,6 +156,9 @@ void settle(const Model& m, State* next, std::vector<int>* fell_asleep) {
   fell_asleep->clear();
   if (!m.options.sleep) return;
   const SimOptions& o = m.options;
+  // a sleeper ODE enabled (a joint tied it to an enabled body) woke, with its island
+  for (int b : m.dynamic_bodies)
+    if (asleep(*next, b) && next->enabled[b]) wake_island(m, next->sleep_island[b], next, nullptr);
   // still time of the awake bodies; touching a moving kinematic body is never still
   std::vector<std::uint8_t> pushed(m.nbody, 0);
   for (const auto& [a, b] : next->contact_pairs) {

@@ -144,15 +144,16 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
         ScopedTimer c(&prof.collide_ms);
         ode_->update_margins(now, ws_.body_force, h);
         double depth = 0.0;
-        prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth);
+        std::vector<std::pair<int, int>>* joined = m.options.sleep ? &ws_.joined : nullptr;
+        prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth, joined);
         next.contact_depth = std::max(next.contact_depth, depth);
-        // a sleeping island touched by a moving body joins this sub-step
-        // (a woken island may touch another one: until none wakes)
-        while (wake_touched(m, next.contact_pairs, moments_, ws_.F, ws_.tau, &next, ode_.get()) > 0) {
+        // a sleeping island that a moving body's contact joint ties (ODE would enable the
+        // sleeper alone) joins this sub-step; a woken island may touch another: until none wakes
+        while (joined && wake_touched(m, *joined, moments_, ws_.F, ws_.tau, &next, ode_.get()) > 0) {
           freeze_sleeping(m, next, &moments_);
           // the woken bodies' contacts with sleeping and static bodies were skipped: again
           ode_->discard_contacts();
-          prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth);
+          prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth, joined);
           next.contact_depth = std::max(next.contact_depth, depth);
         }
         carry_sleeping_pairs(m, state_.contact_pairs, &next);

@@ -39,6 +39,8 @@ struct Workspace {
   EnergyAudit audit;              ///< the energy audit being computed, committed with next
   /// bodies that fell asleep at the attempt's end state (sleep.cpp: settle → finish_sleep)
   std::vector<int> fell_asleep;
+  /// the body pairs the last collisions tied by contact joints (sleep: who touches a sleeper)
+  std::vector<std::pair<int, int>> joined;
 };
 
 }  // namespace magsim::engine
