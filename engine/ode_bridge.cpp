@@ -398,8 +398,23 @@ struct OdeBridge::Impl {
         deepest = std::max(deepest, d);
       }
       dJointID j = dJointCreateContact(world, contact_group, &c);
-      dJointAttach(j, dGeomGetBody(r.g.g1), dGeomGetBody(r.g.g2));
-      if (joined) joined->emplace_back(std::min(tag[r.a].body, tag[r.b].body), std::max(tag[r.a].body, tag[r.b].body));
+      dBodyID b1 = dGeomGetBody(r.g.g1), b2 = dGeomGetBody(r.g.g2);
+      // a gap to a sleeping body (SimOptions::sleep) that the bodies do not close within the
+      // step is held against it as against the world: the awake body cannot pass it, and
+      // ODE does not enable the sleeper for it; one that closes ties them (the sleeper wakes)
+      if (d < 0 && model.options.sleep && b1 && b2 && (!dBodyIsEnabled(b1) || !dBodyIsEnabled(b2))) {
+        const dReal* v1 = dBodyGetLinearVel(b1);
+        const dReal* v2 = dBodyGetLinearVel(b2);
+        const double closing = std::abs((v1[0] - v2[0]) * r.g.normal[0] + (v1[1] - v2[1]) * r.g.normal[1] +
+                                        (v1[2] - v2[2]) * r.g.normal[2]);
+        if (closing * dt < -d) {
+          if (!dBodyIsEnabled(b1)) b1 = nullptr;
+          if (!dBodyIsEnabled(b2)) b2 = nullptr;
+        }
+      }
+      dJointAttach(j, b1, b2);
+      if (joined && b1 && b2)
+        joined->emplace_back(std::min(tag[r.a].body, tag[r.b].body), std::max(tag[r.a].body, tag[r.b].body));
       if (d > -touch) {
         const int ba = tag[r.a].body, bb = tag[r.b].body;
         pairs->emplace_back(std::min(ba, bb), std::max(ba, bb));
