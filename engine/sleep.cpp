@@ -15,8 +15,9 @@
 //     relaxation leaves them as they are, so a sleeping island's own field never changes;
 //   - its forces are still summed with everyone's, but given to no body.
 // It wakes when
-//   - an awake dynamic body or a kinematic body touches one of its bodies (a contact found
-//     by a sub-step's collisions, before that sub-step's rigid step);
+//   - an awake dynamic body or a moving kinematic body overlaps one of its bodies, or closes
+//     the gap to it within the sub-step (a contact joint the sub-step's collisions tie to it,
+//     ode_bridge.cpp; a gap not closed holds the mover as the world would);
 //   - the field at one of its moments has moved by more than
 //       tol · max(|H_sleep|, 0.01 Ms)    (tol = sleep_field_tolerance; Ms → |M| for a magnet)
 //     since the island fell asleep: only awake sources can move it;
