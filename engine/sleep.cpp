@@ -67,6 +67,12 @@ int find(std::vector<int>& parent, int a) {
   return a;
 }
 
+// Joins the sets of a and b; the root is the lower index, so an island's id is its lowest body.
+void unite(std::vector<int>& parent, int a, int b) {
+  const int ra = find(parent, a), rb = find(parent, b);
+  if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+}
+
 void wake_island(const Model& m, int island, State* s, OdeBridge* ode) {
   for (int b : m.dynamic_bodies) {
     if (s->sleep_island[b] != island) continue;
@@ -122,8 +128,6 @@ int wake_touched(const Model& m, const std::vector<std::pair<int, int>>& pairs,
     for (const auto& [sleeper, other] : {std::pair{a, b}, std::pair{b, a}}) {
       if (sleeper < 0 || !asleep(*next, sleeper) || !mover(other)) continue;
       const int island = next->sleep_island[sleeper];
-      for (int c : m.dynamic_bodies)
-        if (next->sleep_island[c] == island) ode->enable(c);  // ODE takes forces of enabled bodies
       // the bodies join this sub-step with the magnetic forces everyone else was given
       for (int c : m.dynamic_bodies) {
         if (next->sleep_island[c] != island) continue;
@@ -184,9 +188,7 @@ void settle(const Model& m, State* next, std::vector<int>* fell_asleep) {
   std::iota(parent.begin(), parent.end(), 0);
   auto joins = [&](int b) { return b >= 0 && m.body_type[b] == BodyType::Dynamic && !asleep(*next, b); };
   for (const auto& [a, b] : next->contact_pairs) {
-    if (!joins(a) || !joins(b)) continue;
-    const int ra = find(parent, a), rb = find(parent, b);
-    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);  // the root: the lowest index
+    if (joins(a) && joins(b)) unite(parent, a, b);
   }
   // an island is restless while a body has not been still for sleep_time, while more than one
   // in kRattlersPer of its bodies rattle (still, but not quiet), or while it touches no body
@@ -246,9 +248,7 @@ int finish_sleep(const Model& m, const std::vector<int>& fell_asleep, const std:
     std::vector<std::uint8_t> fell(m.nbody, 0);
     for (int b : fell_asleep) fell[b] = 1;
     for (const auto& [a, b] : next->contact_pairs) {
-      if (a < 0 || b < 0 || !fell[a] || !fell[b]) continue;
-      const int ra = find(parent, a), rb = find(parent, b);
-      if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+      if (a >= 0 && fell[a] && fell[b]) unite(parent, a, b);
     }
     for (int b : fell_asleep) {
       next->sleep_island[b] = find(parent, b);
@@ -263,11 +263,7 @@ int finish_sleep(const Model& m, const std::vector<int>& fell_asleep, const std:
 void wake_all(const Model& m, State* s) {
   if (s->sleep_island.empty()) return;
   for (int b : m.dynamic_bodies)
-    if (s->sleep_island[b] >= 0) {
-      s->sleep_island[b] = -1;
-      s->still_time[b] = 0.0;
-      s->enabled[b] = 1;
-    }
+    if (s->sleep_island[b] >= 0) wake_island(m, s->sleep_island[b], s, nullptr);
 }
 
 }  // namespace magsim::engine

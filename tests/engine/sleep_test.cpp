@@ -14,16 +14,22 @@ using namespace magsim::test;
 
 namespace {
 
-/// Four balls in a 2×2 layer just above a static magnet standing on the ground, with the
-/// default method (anderson) and sleep on; `drop_height` > 0 adds one more ball that far above
-/// the layer, falling onto it.
-SceneDesc heap_on_magnet(double drop_height) {
+/// An empty scene on one thread with the default method (anderson), sleeping after 0.1 s still.
+SceneDesc sleeping_scene(const std::string& name) {
   SceneDesc s;
-  s.name = "sleep_heap";
+  s.name = name;
   s.options.threads = 1;
   s.options.magnetics.method = mag::Method::Anderson;
   s.options.sleep = true;
   s.options.sleep_time = 0.1;
+  return s;
+}
+
+/// Four balls in a 2×2 layer just above a static magnet standing on the ground, with the
+/// sleeping_scene's options; `drop_height` > 0 adds one more ball that far above
+/// the layer, falling onto it.
+SceneDesc heap_on_magnet(double drop_height) {
+  SceneDesc s = sleeping_scene("sleep_heap");
   s.options.sleep_speed = 0.01;
   s.options.rolling_friction = 0.0005;  // a ball knocked onto the ground stops rolling
   s.options.rolling_friction_bodies = 0.0005;
@@ -80,12 +86,7 @@ TEST_CASE("sleep: a heap on a magnet falls asleep, a dropped ball wakes it, and 
 
 TEST_CASE("sleep: a sleeping ball wakes when a magnet moves toward it from 0.5 m, before it pulls",
           "[sleep]") {
-  SceneDesc s;
-  s.name = "sleep_approach";
-  s.options.threads = 1;
-  s.options.magnetics.method = mag::Method::Anderson;
-  s.options.sleep = true;
-  s.options.sleep_time = 0.1;
+  SceneDesc s = sleeping_scene("sleep_approach");
   s.bodies.push_back(iron_ball("ball", Vec3(0, 0, kR)));
   BodyDesc magnet = cube_magnet(Vec3(-0.5, 0, 0.02), Vec3(1.0, 0, 0));
   magnet.type = BodyType::Kinematic;
