@@ -43,24 +43,17 @@ def magsolve(exe, n, gap, h0, model, tmp):
     return F, mom
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    here = os.path.dirname(os.path.abspath(__file__))
-    ap.add_argument("--fem", default=os.path.join(here, "data", "near_field_fem.csv"))
-    ap.add_argument("--magsolve", default="build/release/tools/magsolve")
-    ap.add_argument("--out", default=os.path.join(here, "data", "near_field_compare.csv"))
-    args = ap.parse_args(argv)
-    if not os.access(args.magsolve, os.X_OK):
-        print(f"near_field_compare.py: {args.magsolve} is not an executable (build it first)", file=sys.stderr)
-        return 2
-    rows = list(csv.DictReader(open(args.fem)))
+def compare(fem, exe):
+    """One row per FEM ball with a non-zero force: the FEM force and moment, and each model's
+    force, force / FEM and moment / FEM (magsolve per arrangement and model)."""
+    rows = list(csv.DictReader(open(fem)))
     groups = collections.OrderedDict()
     for r in rows:
         groups.setdefault((int(r["N"]), float(r["gap_over_a"]), float(r["H0_over_Ms"])), []).append(r)
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         for (n, gap, h0), balls in groups.items():
-            res = {m: magsolve(args.magsolve, n, gap, h0, m, tmp) for m in MODELS}
+            res = {m: magsolve(exe, n, gap, h0, m, tmp) for m in MODELS}
             mom_fem = float(balls[0]["chain_moment_Am2"])
             for b in balls:
                 k = int(b["ball"])
@@ -74,6 +67,20 @@ def main(argv=None):
                     row[f"F_{m}_over_fem"] = res[m][0][k] / f_fem
                     row[f"moment_{m}_over_fem"] = res[m][1] / mom_fem
                 out.append(row)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    here = os.path.dirname(os.path.abspath(__file__))
+    ap.add_argument("--fem", default=os.path.join(here, "data", "near_field_fem.csv"))
+    ap.add_argument("--magsolve", default="build/release/tools/magsolve")
+    ap.add_argument("--out", default=os.path.join(here, "data", "near_field_compare.csv"))
+    args = ap.parse_args(argv)
+    if not os.access(args.magsolve, os.X_OK):
+        print(f"near_field_compare.py: {args.magsolve} is not an executable (build it first)", file=sys.stderr)
+        return 2
+    out = compare(args.fem, args.magsolve)
     with open(args.out, "w", newline="") as fh:
         wr = csv.DictWriter(fh, fieldnames=list(out[0].keys()))
         wr.writeheader()

@@ -388,6 +388,53 @@ def near_field_cost(out):
     plt.close(fig)
 
 
+
+def near_field_tradeoff(out):
+    """The near-field models' cost per step (bench --near-field-cost, one point per scene and
+    model) against their physical error (tools/reference/near_field_chart.py's
+    near_field_accuracy.csv: the share of reference cases outside their marks)."""
+    p = have(out, "near_field_cost.json")
+    q = have(out, "near_field_accuracy.csv")
+    if not p or not q:
+        return
+    with open(p) as f:
+        b = json.load(f)
+    acc = {r["model"]: r for r in rows(q)}
+    runs = [r for r in b.get("runs", []) if r.get("near_field") in acc]
+    if not runs:
+        return
+    measures = (("pair cells outside 0.85–1.15 (two balls, axial, 6 gaps × 8 fields)",
+                 lambda a: 1 - int(a["pair_cells_in_band"]) / int(a["pair_cells"])),
+                ("chains: end ball and moment beyond 25 % (3 and 5 balls, 8 fields)",
+                 lambda a: 1 - int(a["chain_marked_within_25pct"]) / int(a["chain_marked"])))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
+    scenes = list(dict.fromkeys(r["scene"] for r in runs))
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ax, (title, err) in zip(axes, measures):
+        for si, s in enumerate(scenes):
+            pts = []
+            for m, marker in (("dipole", "o"), ("pair", "s")):
+                r = next((r for r in runs if r["scene"] == s and r["near_field"] == m), None)
+                if not r:
+                    continue
+                x, y = err(acc[m]), r["timing_ms"]["total"]["median"]
+                pts.append((x, y))
+                ax.plot(x, y, marker, color=colors[si % len(colors)], ms=8,
+                        label=f"{s}, {m}" if ax is axes[0] else None)
+                ax.annotate(m, (x, y), textcoords="offset points", xytext=(6, 4), fontsize=8)
+            if len(pts) == 2:
+                ax.plot([p_[0] for p_ in pts], [p_[1] for p_ in pts], "-", color=colors[si % len(colors)], lw=0.8)
+        ax.set_xlim(-0.05, 1.05)
+        ax.set_xlabel("share of reference cases outside the mark")
+        ax.set_title(title, fontsize=9)
+        ax.grid(True, alpha=0.3)
+    axes[0].set_ylabel("ms per 1 ms step (median, T_i + T_f + T_r)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("near field: cost per step against physical error", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "near_field_tradeoff.png"), dpi=110)
+    plt.close(fig)
+
 ENERGY_SERIES = (("energy_kinetic", "kinetic K", "tab:blue"),
                  ("energy_gravitational", "gravitational U_g − U_g(0)", "tab:brown"),
                  ("energy_magnetic_work", "magnetic work W_mag", "tab:red"),
@@ -473,7 +520,8 @@ def main():
     if not os.path.isdir(out):
         print(f"charts: {out} is not a directory", file=sys.stderr)
         sys.exit(2)
-    for f in (fig8, fig9, fig10, speed, snapshot_speed, tolerance, bench, near_field_cost):
+    for f in (fig8, fig9, fig10, speed, snapshot_speed, tolerance, bench, near_field_cost,
+              near_field_tradeoff):
         f(out)
     print(f"charts: written to {out}")
 

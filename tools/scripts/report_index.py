@@ -276,9 +276,13 @@ def main():
     nf = os.path.join(out, "near_field.txt")
     if os.path.exists(nf):
         L.append("```\n" + open(nf).read().strip() + "\n```\n")
-    L.append("One dipole per ball against the exact linear two-sphere force (weak field) and the "
-             "finite-element force (g = 0.003a, H0/Ms = 1e-4…10), for `--near-field dipole` and "
-             "`pair` (tools/findings/near_field.md).\n")
+    L.append("One dipole per ball against the exact linear two-sphere force (weak field, axial and "
+             "transverse) and our finite-element force (axial, every gap 0.003a–a × H0/Ms 0.001–3; "
+             "T/C: the training and check halves), for `--near-field dipole` and `pair` "
+             "(tools/findings/near_field_reference.md).\n")
+    L.append(img(out, "near_field_chains.png", "near field chains"))
+    L.append("Chains of 3 and 5 balls at g = 0.003a along the field: the end ball's force, the "
+             "middle ball's (5) and the chain's moment against the finite-element ones.\n")
     nfc = load(out, "near_field_cost.json")
     if nfc and nfc.get("near_field_cost"):
         L.append(img(out, "near_field_cost.png", "near field cost"))
@@ -292,6 +296,11 @@ def main():
                 L.append(f"| {s} | {m} | {q['dipole_total_ms']:.2f} | {q['pair_total_ms']:.2f} | "
                          f"{q['pair_over_dipole']:.2f} |")
         L.append("")
+
+    if os.path.exists(os.path.join(out, "near_field_tradeoff.png")):
+        L.append(img(out, "near_field_tradeoff.png", "near field cost against error"))
+        L.append("Cost per step of each near-field model against the share of reference cases "
+                 "outside their marks (near_field_accuracy.csv).\n")
 
     L.append("## Speed against accuracy (beyond the paper)\n")
     L.append(img(out, "speed_accuracy.png", "speed against accuracy"))
