@@ -1,12 +1,14 @@
 // magnetics/simd.hpp — internal: the lane operations of the field kernels, in two sets that
 // give the same bits: portable lanes (PD, PF: GCC generic vectors that the compiler splits into
 // the CPU's width) and AVX-512 registers (__m512d, __m512). A kernel body is written once over
-// these names (pair_sweep.inc, far_block.inc) and compiled for both sets, so its result does
-// not depend on the CPU. Every operation is element-wise IEEE (+, −, ×, ÷, √, max, compare,
-// select), FMA is never used ("mul_add" rounds twice), sums across lanes follow one tree
-// (hsum), and 1/√q is computed the same way on both (inv_sqrt). Double kernels run 8 lanes,
-// float kernels 16, whatever the hardware width. Include only from magnetics/*.cpp, after
-// field_kernel.hpp.
+// these names (pair_sweep.inc, far_block.inc) and compiled for both sets (the portable lanes
+// twice: for any x86-64 and for AVX2+FMA), so its result does not depend on the CPU. Every
+// operation is element-wise IEEE and correctly rounded (+, −, ×, ÷, √, fused a·b + c, max,
+// compare, select), sums across lanes follow one tree (hsum), and 1/√q is 1 ÷ √q on both.
+// mul_add is always fused, never contracted by the compiler: one rounding on every CPU, in
+// the FMA instruction or, on a CPU without it, in glibc's fma (exact in software). Double
+// kernels run 8 lanes, float kernels 16, whatever the hardware width. Include only from
+// magnetics/*.cpp, after field_kernel.hpp.
 #pragma once
 
 #include "magnetics/field_kernel.hpp"
@@ -100,10 +102,14 @@ inline PF ld(const float* p, PF) {
     for (int k = 0; k < N; ++k) r.m[k] = static_cast<std::size_t>(k) < n ? -1 : 0;           \
     return r;                                                                                \
   }                                                                                          \
-  /* a·b + c and c − a·b, rounded twice (never fused); a·x + b·y + c·z left to right */      \
-  inline P mul_add(P a, P b, P c) { return add(mul(a, b), c); }                              \
-  inline P neg_mul_add(P a, P b, P c) { return sub(c, mul(a, b)); }                          \
-  inline P dot3(P a, P b, P c, P x, P y, P z) { return add(add(mul(a, x), mul(b, y)), mul(c, z)); }
+  /* a·b + c and c − a·b fused (one rounding); a·x + b·y + c·z as fma(c, z, fma(b, y, a·x)) */ \
+  inline P mul_add(P a, P b, P c) {                                                          \
+    P r;                                                                                     \
+    for (int k = 0; k < N; ++k) r.v[k] = __builtin_fma(a.v[k], b.v[k], c.v[k]);              \
+    return r;                                                                                \
+  }                                                                                          \
+  inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
+  inline P dot3(P a, P b, P c, P x, P y, P z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
 MAGSIM_PORTABLE_OPS(PD, MD, double, 8)
 MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 #undef MAGSIM_PORTABLE_OPS
@@ -126,16 +132,11 @@ inline V cst(double x) {
   return splat(V(), x);
 }
 
-/// 1/√q in the lanes of m, 0 elsewhere; see inv_sqrt for __m512d
+/// 1/√q as 1 ÷ √q (two correctly rounded steps) in the lanes of m, 0 elsewhere
 inline PD inv_sqrt(MD m, PD q) {
-  VecF8 f = __builtin_convertvector(q.v, VecF8);
-  VecF8 s;
-  for (int k = 0; k < 8; ++k) s[k] = std::sqrt(f[k]);
-  f = 1.0f / s;
-  PD y{__builtin_convertvector(f, VecD8)};
-  const VecD8 h = 0.5 * q.v;
-  for (int it = 0; it < 2; ++it) y.v = y.v * (1.5 - h * (y.v * y.v));
-  return keep(m, y);
+  PD s;
+  for (int k = 0; k < 8; ++k) s.v[k] = std::sqrt(q.v[k]);
+  return keep(m, PD{1.0 / s.v});
 }
 inline PF inv_sqrt(MF m, PF q) {
   PF s;
@@ -230,27 +231,19 @@ template <>
 inline V8 cst<V8>(double x) { return _mm512_set1_pd(x); }
 template <>
 inline V16 cst<V16>(double x) { return _mm512_set1_ps(static_cast<float>(x)); }
-// mul_add, neg_mul_add, dot3 as for the portable lanes (never fused)
-#define MAGSIM_AVX_HELPERS(V)                                                       \
-  inline V mul_add(V a, V b, V c) { return add(mul(a, b), c); }                     \
-  inline V neg_mul_add(V a, V b, V c) { return sub(c, mul(a, b)); }                 \
-  inline V dot3(V a, V b, V c, V x, V y, V z) { return add(add(mul(a, x), mul(b, y)), mul(c, z)); }
-MAGSIM_AVX_HELPERS(V8)
-MAGSIM_AVX_HELPERS(V16)
-#undef MAGSIM_AVX_HELPERS
+// mul_add, neg_mul_add, dot3 as for the portable lanes (fused: one rounding)
+inline V8 mul_add(V8 a, V8 b, V8 c) { return _mm512_fmadd_pd(a, b, c); }
+inline V16 mul_add(V16 a, V16 b, V16 c) { return _mm512_fmadd_ps(a, b, c); }
+inline V8 neg_mul_add(V8 a, V8 b, V8 c) { return _mm512_fnmadd_pd(a, b, c); }
+inline V16 neg_mul_add(V16 a, V16 b, V16 c) { return _mm512_fnmadd_ps(a, b, c); }
+inline V8 dot3(V8 a, V8 b, V8 c, V8 x, V8 y, V8 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
+inline V16 dot3(V16 a, V16 b, V16 c, V16 x, V16 y, V16 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
 
-/// 1/√q in the lanes of k (0 elsewhere), the same bits as the portable lanes: a float start
-/// 1/√(float q) (correctly rounded steps: relative error < 1e-7), then two Newton steps in
-/// double, y ← y (3/2 − (q/2) y²), each squaring the error (< 1e-28 after the second), so
-/// that the result is within a few ulp of 1/√q. (q must lie in float's normal range, as
-/// every separation the kernels see does: 1e-19 … 1e19 m².)
+/// 1/√q as 1 ÷ √q in the lanes of k (0 elsewhere), the same bits as the portable lanes: two
+/// correctly rounded steps, within 1.5 ulp of 1/√q (cheaper here than a float start and two
+/// Newton steps, and exact-rounding on every CPU)
 inline V8 inv_sqrt(__mmask8 k, V8 q) {
-  const __m256 qf = _mm512_maskz_cvtpd_ps(0xff, q);
-  const __m256 yf = _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(qf));
-  V8 y = _mm512_maskz_cvtps_pd(0xff, yf);
-  const V8 h = mul(_mm512_set1_pd(0.5), q), c = _mm512_set1_pd(1.5);
-  for (int it = 0; it < 2; ++it) y = mul(y, sub(c, mul(h, mul(y, y))));
-  return keep(k, y);
+  return _mm512_maskz_div_pd(k, _mm512_set1_pd(1.0), _mm512_maskz_sqrt_pd(k, q));
 }
 /// 1/√q in float, correctly rounded steps (√ then ÷) in the lanes of k, 0 elsewhere
 inline V16 inv_sqrt(__mmask16 k, V16 q) {
