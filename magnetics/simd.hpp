@@ -74,6 +74,11 @@ inline PF ld(const float* p, PF) {
   return r;
 }
 
+/// One lane's fused a·b + c in its own precision (fmaf for float: a float fma computed in
+/// double and then rounded to float would round twice)
+inline double fma_lane(double a, double b, double c) { return __builtin_fma(a, b, c); }
+inline float fma_lane(float a, float b, float c) { return __builtin_fmaf(a, b, c); }
+
 #define MAGSIM_PORTABLE_OPS(P, M, T, N)                                                      \
   inline P add(P a, P b) { return P{a.v + b.v}; }                                            \
   inline P sub(P a, P b) { return P{a.v - b.v}; }                                            \
@@ -105,7 +110,7 @@ inline PF ld(const float* p, PF) {
   /* a·b + c and c − a·b fused (one rounding); a·x + b·y + c·z as fma(c, z, fma(b, y, a·x)) */ \
   inline P mul_add(P a, P b, P c) {                                                          \
     P r;                                                                                     \
-    for (int k = 0; k < N; ++k) r.v[k] = __builtin_fma(a.v[k], b.v[k], c.v[k]);              \
+    for (int k = 0; k < N; ++k) r.v[k] = fma_lane(a.v[k], b.v[k], c.v[k]);                   \
     return r;                                                                                \
   }                                                                                          \
   inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
