@@ -6,7 +6,7 @@
 // operation is element-wise IEEE and correctly rounded (+, −, ×, ÷, √, fused a·b + c, max,
 // compare, select), sums across lanes follow one tree (hsum), and 1/√q is 1 ÷ √q on both.
 // mul_add is always fused, never contracted by the compiler: one rounding on every CPU, in
-// the FMA instruction or, on a CPU without it, in glibc's fma (exact in software). Double
+// the FMA instruction or, on a CPU without it, in soft_fma's exact emulation below. Double
 // kernels run 8 lanes, float kernels 16, whatever the hardware width. Include only from
 // magnetics/*.cpp, after field_kernel.hpp.
 #pragma once
