@@ -66,6 +66,7 @@ std::size_t chunk_blocks(std::size_t nb, std::size_t per_sum) {
 
 // The series over portable lanes (any CPU) …
 namespace portable {
+using namespace detail::simd::fused_soft;  // no FMA instruction: a·b + c in +, −, ×
 template <class T>
 using LaneOf = detail::simd::PortableLaneOf<T>;
 #include "magnetics/far_block.inc"
@@ -76,6 +77,7 @@ using LaneOf = detail::simd::PortableLaneOf<T>;
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace fma {
+using namespace detail::simd::fused_hw;  // one FMA instruction per register
 template <class T>
 using LaneOf = detail::simd::PortableLaneOf<T>;
 #include "magnetics/far_block.inc"

@@ -124,7 +124,7 @@ inline constexpr std::size_t kChunkF = 1024;
 enum class KernelPath {
   Avx512,   ///< AVX-512 registers (native builds, CPUs with AVX-512F)
   Fma,      ///< portable lanes compiled for AVX2+FMA (CPUs with both)
-  Generic,  ///< portable lanes for any x86-64: each fused multiply-add is glibc's fma
+  Generic,  ///< portable lanes for any x86-64: fused multiply-adds emulated (simd.hpp soft_fma)
 };
 /// "avx512", "fma" or "generic"
 const char* kernel_path_name(KernelPath p);

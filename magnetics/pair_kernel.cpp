@@ -64,6 +64,7 @@ void finish(const double* acc, bool jac, double* Hout, double* Jout) {
 
 // The sweep over portable lanes (any CPU) …
 namespace portable {
+using namespace simd::fused_soft;  // no FMA instruction: a·b + c in +, −, ×
 template <class T>
 using LaneOf = simd::PortableLaneOf<T>;
 #include "magnetics/pair_sweep.inc"
@@ -74,6 +75,7 @@ using LaneOf = simd::PortableLaneOf<T>;
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace fma {
+using namespace simd::fused_hw;  // one FMA instruction per register
 template <class T>
 using LaneOf = simd::PortableLaneOf<T>;
 #include "magnetics/pair_sweep.inc"

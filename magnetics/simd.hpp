@@ -6,7 +6,7 @@
 // operation is element-wise IEEE and correctly rounded (+, −, ×, ÷, √, fused a·b + c, max,
 // compare, select), sums across lanes follow one tree (hsum), and 1/√q is 1 ÷ √q on both.
 // mul_add is always fused, never contracted by the compiler: one rounding on every CPU, in
-// the FMA instruction or, on a CPU without it, in glibc's fma (exact in software). Double
+// the FMA instruction or, on a CPU without it, in soft_fma's exact emulation below. Double
 // kernels run 8 lanes, float kernels 16, whatever the hardware width. Include only from
 // magnetics/*.cpp, after field_kernel.hpp.
 #pragma once
@@ -74,11 +74,6 @@ inline PF ld(const float* p, PF) {
   return r;
 }
 
-/// One lane's fused a·b + c in its own precision (fmaf for float: a float fma computed in
-/// double and then rounded to float would round twice)
-inline double fma_lane(double a, double b, double c) { return __builtin_fma(a, b, c); }
-inline float fma_lane(float a, float b, float c) { return __builtin_fmaf(a, b, c); }
-
 #define MAGSIM_PORTABLE_OPS(P, M, T, N)                                                      \
   inline P add(P a, P b) { return P{a.v + b.v}; }                                            \
   inline P sub(P a, P b) { return P{a.v - b.v}; }                                            \
@@ -106,18 +101,158 @@ inline float fma_lane(float a, float b, float c) { return __builtin_fmaf(a, b, c
     M r;                                                                                     \
     for (int k = 0; k < N; ++k) r.m[k] = static_cast<std::size_t>(k) < n ? -1 : 0;           \
     return r;                                                                                \
-  }                                                                                          \
-  /* a·b + c and c − a·b fused (one rounding); a·x + b·y + c·z as fma(c, z, fma(b, y, a·x)) */ \
-  inline P mul_add(P a, P b, P c) {                                                          \
-    P r;                                                                                     \
-    for (int k = 0; k < N; ++k) r.v[k] = fma_lane(a.v[k], b.v[k], c.v[k]);                   \
-    return r;                                                                                \
-  }                                                                                          \
-  inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
-  inline P dot3(P a, P b, P c, P x, P y, P z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
+  }
 MAGSIM_PORTABLE_OPS(PD, MD, double, 8)
 MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 #undef MAGSIM_PORTABLE_OPS
+
+// ---- fused a·b + c of the portable lanes -------------------------------------------------
+//
+// Two sets of mul_add, neg_mul_add and dot3 with the same bits; each instance of a kernel
+// body picks one with a using-directive before its #include (pair_kernel.cpp,
+// barnes_hut_far.cpp). The header cannot pick by itself: GCC 12 does not change __FMA__
+// inside a `#pragma GCC target` region, and these functions are defined outside any.
+//   fused_hw:   __builtin_fma per lane, one FMA instruction per register in the AVX2+FMA
+//               instance (a call to glibc's fma, ~200× slower in software, elsewhere);
+//   fused_soft: for the instance of a CPU without FMA: soft_fma below, in +, −, × and bit
+//               operations that SSE2 vectorizes (__builtin_fma where the whole build has FMA).
+
+/// Correctly rounded (round-to-nearest-even) a·b + c lane by lane, bit for bit the FMA
+/// instruction's result, from element-wise +, −, ×: no FMA instruction needed.
+namespace soft_fma {
+
+/// s + e = x + y exactly, s = RN(x + y) (Knuth's TwoSum; exact unless x + y overflows)
+inline void two_sum(VecD8 x, VecD8 y, VecD8& s, VecD8& e) {
+  s = x + y;
+  const VecD8 yv = s - x;
+  e = (x - (s - yv)) + (y - yv);
+}
+
+/// x = hi + lo, each with at most 26 significant bits (Veltkamp's splitting, C = 2^27 + 1;
+/// exact while C·x does not overflow)
+inline void split(VecD8 x, VecD8& hi, VecD8& lo) {
+  const VecD8 g = x * 134217729.0;
+  hi = g - (g - x);
+  lo = x - hi;
+}
+
+/// RO(s + e), rounded to odd (s = RN(s + e), e its error from two_sum): s where e = 0 or
+/// s's last significand bit is 1, else s's neighbour toward e (± 1 on the bit pattern of s,
+/// which is nonzero since a sum that rounds to 0 is exact). A NaN e (inf or NaN inputs)
+/// changes nothing. Sign tests by floating compare: SSE2 has no 64-bit integer compare.
+inline VecD8 round_odd(VecD8 s, VecD8 e) {
+  const VecI64x8 bits = __builtin_bit_cast(VecI64x8, s);
+  const VecI64x8 same = ((e > 0.0) & (s > 0.0)) | ((e < 0.0) & (s < 0.0));
+  const VecI64x8 opposite = ((e > 0.0) & (s < 0.0)) | ((e < 0.0) & (s > 0.0));
+  const VecI64x8 even = (bits & 1) ^ 1;
+  const VecI64x8 r = bits + (even & same) - (even & opposite);
+  return __builtin_bit_cast(VecD8, r);
+}
+
+// Double lanes with every input nonzero in [2^-450, 2^450] (kLo, kHi): C·x stays below 2^478,
+// a·b below 2^900, and every term of the algorithm is a multiple of 2^-1004 (ulp(a) ulp(b)
+// ≥ 2^-502 · 2^-502, ulp(c) ≥ 2^-502), so no step overflows or leaves the normal range and
+// the proof for an unbounded exponent applies.
+constexpr double kLo = 0x1p-450, kHi = 0x1p450;
+
+/// Scalar std::fma in the lanes where ok is 0 (inputs out of range, inf or NaN: rare)
+[[gnu::noinline, gnu::cold]] inline void fma_lanes(VecD8& r, const VecI64x8& ok, const VecD8& a,
+                                                  const VecD8& b, const VecD8& c) {
+  for (int k = 0; k < 8; ++k)
+    if (ok[k] == 0) r[k] = std::fma(a[k], b[k], c[k]);
+}
+
+/// RN(a·b + c) in double lanes (Boldo & Melquiond, "Emulation of FMA and correctly rounded
+/// sums: proved algorithms using rounding to odd", IEEE TC 2008): a·b = uh + ul exactly
+/// (Dekker's product on Veltkamp's halves), th + tl = c + uh (TwoSum), v = RO(tl + ul),
+/// result RN(th + v). Lanes with a or b zero: a·b + c as two operations (the product ±0 is
+/// exact); with c zero and a·b not: RN(a·b); out of range: std::fma. An exact cancellation
+/// gives th = +0 and v = ±0, so +0 as RN has it.
+[[gnu::always_inline]] inline VecD8 fma(VecD8 a, VecD8 b, VecD8 c) {
+  const VecD8 uh = a * b;
+  VecD8 ah, al, bh, bl;
+  split(a, ah, al);
+  split(b, bh, bl);
+  const VecD8 ul = (((ah * bh - uh) + ah * bl) + al * bh) + al * bl;
+  VecD8 th, tl, s, e;
+  two_sum(c, uh, th, tl);
+  two_sum(tl, ul, s, e);
+  const VecD8 r = th + round_odd(s, e);
+  const VecI64x8 zero_ab = (a == 0.0) | (b == 0.0), zero_c = c == 0.0;
+  const VecI64x8 abs_mask = ~(VecI64x8{} + INT64_MIN);
+  const auto in = [&](VecD8 x) {
+    const VecD8 ax = __builtin_bit_cast(VecD8, __builtin_bit_cast(VecI64x8, x) & abs_mask);
+    return (ax >= kLo) & (ax <= kHi);
+  };
+  const VecI64x8 ok = zero_ab | zero_c | (in(a) & in(b) & in(c));
+  VecD8 out = zero_ab ? uh + c : (zero_c ? uh : r);
+  std::int64_t all = -1;
+  for (int k = 0; k < 8; ++k) all &= ok[k];
+  if (all == 0) fma_lanes(out, ok, a, b, c);
+  return out;
+}
+
+/// RN(a·b + c) in float lanes: RN_float(RO_double(a·b + c)). a·b is exact in double (24 + 24
+/// bits, exponents far inside double's range), TwoSum of it and c is exact, and rounding to
+/// odd in 53 ≥ 24 + 2 bits and then to nearest in 24 rounds once (Boldo & Melquiond, as
+/// above), subnormal and overflowing float results included. Plain RN_double instead would
+/// round twice. Zeros, infs and NaNs follow IEEE in every step: no special lanes.
+inline VecD8 fma_f_in_double(VecD8 a, VecD8 b, VecD8 c) {
+  VecD8 s, e;
+  two_sum(a * b, c, s, e);
+  return round_odd(s, e);
+}
+[[gnu::always_inline]] inline VecF16 fma(VecF16 a, VecF16 b, VecF16 c) {
+  VecF8 h[3][2];
+  std::memcpy(h[0], &a, sizeof a);
+  std::memcpy(h[1], &b, sizeof b);
+  std::memcpy(h[2], &c, sizeof c);
+  VecF8 r[2];
+  for (int i = 0; i < 2; ++i) {
+    const VecD8 x = fma_f_in_double(__builtin_convertvector(h[0][i], VecD8),
+                                    __builtin_convertvector(h[1][i], VecD8),
+                                    __builtin_convertvector(h[2][i], VecD8));
+    r[i] = __builtin_convertvector(x, VecF8);
+  }
+  VecF16 out;
+  std::memcpy(&out, r, sizeof out);
+  return out;
+}
+
+}  // namespace soft_fma
+
+// a·b + c and c − a·b fused (one rounding); a·x + b·y + c·z as fma(c, z, fma(b, y, a·x))
+#define MAGSIM_FUSED_OPS(P)                                                                  \
+  inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
+  inline P dot3(P a, P b, P c, P x, P y, P z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
+
+namespace fused_hw {
+inline PD mul_add(PD a, PD b, PD c) {
+  PD r;
+  for (int k = 0; k < 8; ++k) r.v[k] = __builtin_fma(a.v[k], b.v[k], c.v[k]);
+  return r;
+}
+inline PF mul_add(PF a, PF b, PF c) {
+  PF r;
+  for (int k = 0; k < 16; ++k) r.v[k] = __builtin_fmaf(a.v[k], b.v[k], c.v[k]);
+  return r;
+}
+MAGSIM_FUSED_OPS(PD)
+MAGSIM_FUSED_OPS(PF)
+}  // namespace fused_hw
+
+namespace fused_soft {
+#ifdef __FMA__
+using fused_hw::mul_add;
+#else
+inline PD mul_add(PD a, PD b, PD c) { return PD{soft_fma::fma(a.v, b.v, c.v)}; }
+inline PF mul_add(PF a, PF b, PF c) { return PF{soft_fma::fma(a.v, b.v, c.v)}; }
+#endif
+MAGSIM_FUSED_OPS(PD)
+MAGSIM_FUSED_OPS(PF)
+}  // namespace fused_soft
+
+#undef MAGSIM_FUSED_OPS
 
 /// The portable lane set of a scalar type (a kernel body reads LaneOf<T>::V)
 template <class T>

@@ -11,10 +11,9 @@ summary.json's state_hash with the one golden table (tests/engine/golden_hashes.
                of a CPU without FMA or AVX2 (the engine must not reach libm's rounding)
   2-threads    --threads 2 instead of 1
   generic      MAGSIM_KERNEL=generic: the kernels of a CPU without FMA, each fused
-               multiply-add a call to glibc's fma (FMA instruction inside)
-  no-fma       generic with the sse2-libm tunables: glibc's fma in software, as on a CPU
-               without FMA (about 100x slower: only the scenes of NO_FMA_SCENES unless
-               --scenes names others)
+               multiply-add emulated in +, -, x (magnetics/simd.hpp soft_fma)
+  no-fma       generic with the sse2-libm tunables, as on a CPU without FMA (only the
+               scenes of NO_FMA_SCENES unless --scenes names others)
 
 A binary built with -DMAGSIM_NATIVE=OFF is the portable build; one built with
 -DMAGSIM_MARCH=x86-64-v3 (or -v2) is a native build for a CPU with AVX2 and FMA (or
