@@ -1,7 +1,8 @@
 // magnetics/barnes_hut_far.cpp — the far-cell series of Barnes–Hut (barnes_hut.cpp). One
-// body (far_block.inc) is compiled over portable lanes and over AVX-512 registers, each in
-// double (CellBuffer, 8 cells per block) and in single precision (CellBufferF, 16 cells per
-// block, BarnesHutOptions::far_float); the two give the same bits (simd.hpp).
+// body (far_block.inc) is compiled over portable lanes (for any CPU and for AVX2+FMA) and
+// over AVX-512 registers, each in double (CellBuffer, 8 cells per block) and in single
+// precision (CellBufferF, 16 cells per block, BarnesHutOptions::far_float); all give the same
+// bits (simd.hpp).
 #include "magnetics/barnes_hut_internal.hpp"
 #include "magnetics/simd.hpp"
 
@@ -65,10 +66,24 @@ std::size_t chunk_blocks(std::size_t nb, std::size_t per_sum) {
 
 // The series over portable lanes (any CPU) …
 namespace portable {
+using namespace detail::simd::fused_soft;  // no FMA instruction: a·b + c in +, −, ×
 template <class T>
 using LaneOf = detail::simd::PortableLaneOf<T>;
 #include "magnetics/far_block.inc"
 }  // namespace portable
+
+#ifdef MAGSIM_FMA_KERNEL
+// … over the same lanes where the CPU has AVX2 and FMA …
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+namespace fma {
+using namespace detail::simd::fused_hw;  // one FMA instruction per register
+template <class T>
+using LaneOf = detail::simd::PortableLaneOf<T>;
+#include "magnetics/far_block.inc"
+}  // namespace fma
+#pragma GCC pop_options
+#endif
 
 #ifdef MAGSIM_AVX512_KERNEL
 // … and over AVX-512 registers: the same source, the same bits
@@ -87,10 +102,18 @@ namespace {
 template <class T, bool kH, bool kJ>
 void far_run(const typename FarPrecision<T>::Buffer& cb, int order, const T* p, T eps2,
              double sH, double sJ, double* H, double* J) {
+  const detail::KernelPath path = detail::kernel_path();
 #ifdef MAGSIM_AVX512_KERNEL
-  if (detail::simd_kernel_active()) {
+  if (path == detail::KernelPath::Avx512) {
     if (order >= 2) avx512::far_lanes<T, kH, kJ, 2>(cb, p, eps2, sH, sJ, H, J);
     else avx512::far_lanes<T, kH, kJ, 1>(cb, p, eps2, sH, sJ, H, J);
+    return;
+  }
+#endif
+#ifdef MAGSIM_FMA_KERNEL
+  if (path == detail::KernelPath::Fma) {
+    if (order >= 2) fma::far_lanes<T, kH, kJ, 2>(cb, p, eps2, sH, sJ, H, J);
+    else fma::far_lanes<T, kH, kJ, 1>(cb, p, eps2, sH, sJ, H, J);
     return;
   }
 #endif

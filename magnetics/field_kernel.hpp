@@ -22,6 +22,11 @@
 #define MAGSIM_AVX512_KERNEL 1
 #define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
 #endif
+// The portable lanes are also compiled for AVX2+FMA (per region, chosen at run time), in
+// every x86-64 build: there their fused multiply-adds are single instructions.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define MAGSIM_FMA_KERNEL 1
+#endif
 
 namespace magsim::mag::detail {
 
@@ -114,21 +119,33 @@ void sum_pairs_f32(const SourceViewF& v, const TargetF& t, float eps2, PairTerms
 /// 256 with the same error (float vs double near field RMS ~4e-7 either way).
 inline constexpr std::size_t kChunkF = 1024;
 
-/// True when sum_pairs (and the Barnes–Hut far-cell kernels, double and float) run the
-/// AVX-512 path: the build has it (not -DMAGSIM_NATIVE=OFF), the CPU has it, the
-/// environment does not force the portable loops and it has not been switched off.
+/// The three instances of the field kernels (sum_pairs, sum_pairs_f32 and the Barnes–Hut
+/// far cells), fastest first. They give the same bits; the choice changes speed only.
+enum class KernelPath {
+  Avx512,   ///< AVX-512 registers (native builds, CPUs with AVX-512F)
+  Fma,      ///< portable lanes compiled for AVX2+FMA (CPUs with both)
+  Generic,  ///< portable lanes for any x86-64: fused multiply-adds emulated (simd.hpp soft_fma)
+};
+/// "avx512", "fma" or "generic"
+const char* kernel_path_name(KernelPath p);
+
+/// The path the kernels take: the fastest that the build has, the CPU has, the environment
+/// allows and limit_kernel_path has not excluded.
 ///
-/// MAGSIM_KERNEL=portable in the environment (read once, at the first field evaluation)
-/// forces the portable loops in any build, so that one CPU can run the path another CPU
-/// would; unset or any other value: AVX-512 where the CPU has it. (The command-line
-/// programs accept only unset, "auto" or "portable", tools/cli/cli_common.hpp.) The two
-/// paths give the same bits; the choice changes speed only.
+/// MAGSIM_KERNEL in the environment (read once, at the first field evaluation): "portable"
+/// excludes AVX-512 (the path of a CPU with AVX2+FMA but no AVX-512), "generic" excludes FMA
+/// too (the path of a CPU without FMA); unset or "auto": the fastest. (The command-line
+/// programs refuse any other value, tools/cli/cli_common.hpp.)
+KernelPath kernel_path();
+/// For tests and benchmarks that compare the paths: at most `fastest` from now on (Avx512:
+/// no limit); the environment's limit still holds. Not to be called while a field
+/// evaluation runs.
+void limit_kernel_path(KernelPath fastest);
+/// kernel_path() == KernelPath::Avx512
 bool simd_kernel_active();
-/// Switches the AVX-512 path off (false) or back on, for tests and benchmarks that compare
-/// it with the portable loop; "on" cannot override MAGSIM_KERNEL=portable. Not to be called
-/// while a field evaluation runs.
+/// limit_kernel_path(on ? Avx512 : Fma): the AVX-512 path off or back on
 void enable_simd_kernel(bool on);
-/// True when MAGSIM_KERNEL=portable was set in the environment (read once).
+/// True when MAGSIM_KERNEL was set to "portable" or "generic" (read once).
 bool portable_kernel_forced();
 
 }  // namespace magsim::mag::detail

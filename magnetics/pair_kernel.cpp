@@ -1,9 +1,9 @@
 // magnetics/pair_kernel.cpp — the pair kernel of field_kernel.hpp (sum_pairs in double for
 // the direct sum and the Barnes–Hut near field, sum_pairs_f32 in float for the Barnes–Hut
-// near field). One body (pair_sweep.inc) is compiled twice: over portable lanes for any CPU
-// and over AVX-512 registers where the CPU has them. Both run 8 double or 16 float lanes
-// with the same operations in the same order (simd.hpp), so they give the same bits, and
-// the choice between them changes speed only. Float sums run over chunks of kChunkF sources
+// near field). One body (pair_sweep.inc) is compiled three times: over portable lanes for
+// any CPU, over the same lanes for AVX2+FMA, and over AVX-512 registers. All run 8 double or
+// 16 float lanes with the same operations in the same order (simd.hpp), so they give the
+// same bits, and the choice between them (kernel_path) changes speed only. Float sums run over chunks of kChunkF sources
 // per lane set and are then added in double, so the float rounding of the sum does not grow
 // with the list; a double sweep is one chunk.
 #include "magnetics/field_kernel.hpp"
@@ -64,10 +64,24 @@ void finish(const double* acc, bool jac, double* Hout, double* Jout) {
 
 // The sweep over portable lanes (any CPU) …
 namespace portable {
+using namespace simd::fused_soft;  // no FMA instruction: a·b + c in +, −, ×
 template <class T>
 using LaneOf = simd::PortableLaneOf<T>;
 #include "magnetics/pair_sweep.inc"
 }  // namespace portable
+
+#ifdef MAGSIM_FMA_KERNEL
+// … over the same lanes where the CPU has AVX2 and FMA …
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+namespace fma {
+using namespace simd::fused_hw;  // one FMA instruction per register
+template <class T>
+using LaneOf = simd::PortableLaneOf<T>;
+#include "magnetics/pair_sweep.inc"
+}  // namespace fma
+#pragma GCC pop_options
+#endif
 
 #ifdef MAGSIM_AVX512_KERNEL
 // … and over AVX-512 registers: the same source, the same bits
@@ -83,25 +97,50 @@ using LaneOf = simd::Avx512LaneOf<T>;
 
 namespace {
 
+// The fastest path this build and CPU have; MAGSIM_KERNEL's limit (read once)
+KernelPath cpu_best() {
+  static const KernelPath best = [] {
 #ifdef MAGSIM_AVX512_KERNEL
-bool cpu_has_avx512() {
-  static const bool has = __builtin_cpu_supports("avx512f");
-  return has;
-}
-
+    if (__builtin_cpu_supports("avx512f")) return KernelPath::Avx512;
 #endif
+#ifdef MAGSIM_FMA_KERNEL
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return KernelPath::Fma;
+#endif
+    return KernelPath::Generic;
+  }();
+  return best;
+}
+KernelPath env_limit() {
+  static const KernelPath limit = [] {
+    const char* v = std::getenv("MAGSIM_KERNEL");
+    if (v != nullptr && std::strcmp(v, "generic") == 0) return KernelPath::Generic;
+    if (v != nullptr && std::strcmp(v, "portable") == 0) return KernelPath::Fma;
+    return KernelPath::Avx512;
+  }();
+  return limit;
+}
+// the slower (larger) of two paths
+KernelPath slower(KernelPath a, KernelPath b) { return a > b ? a : b; }
 
-std::atomic<bool> g_simd_enabled{true};
+std::atomic<KernelPath> g_limit{KernelPath::Avx512};
 
-// Picks the instance: AVX-512 or portable, with or without J, bounded or not.
+// Picks the instance: AVX-512, FMA or generic, with or without J, bounded or not.
 template <class View>
 void dispatch(const View& v, const typename Precision<View>::Tgt& t,
               typename Precision<View>::T eps2, PairTerms terms, double* H, double* J) {
   const bool bound = v.rad != nullptr, jac = terms == PairTerms::HJ;
+  const KernelPath path = kernel_path();
 #ifdef MAGSIM_AVX512_KERNEL
-  if (simd_kernel_active()) {
+  if (path == KernelPath::Avx512) {
     if (jac) bound ? avx512::sweep<true, true>(v, t, eps2, H, J) : avx512::sweep<true, false>(v, t, eps2, H, J);
     else bound ? avx512::sweep<false, true>(v, t, eps2, H, J) : avx512::sweep<false, false>(v, t, eps2, H, J);
+    return;
+  }
+#endif
+#ifdef MAGSIM_FMA_KERNEL
+  if (path == KernelPath::Fma) {
+    if (jac) bound ? fma::sweep<true, true>(v, t, eps2, H, J) : fma::sweep<true, false>(v, t, eps2, H, J);
+    else bound ? fma::sweep<false, true>(v, t, eps2, H, J) : fma::sweep<false, false>(v, t, eps2, H, J);
     return;
   }
 #endif
@@ -111,24 +150,26 @@ void dispatch(const View& v, const typename Precision<View>::Tgt& t,
 
 }  // namespace
 
-void enable_simd_kernel(bool on) { g_simd_enabled = on; }
-
-bool portable_kernel_forced() {
-  static const bool forced = [] {
-    const char* v = std::getenv("MAGSIM_KERNEL");
-    return v != nullptr && std::strcmp(v, "portable") == 0;
-  }();
-  return forced;
+const char* kernel_path_name(KernelPath p) {
+  switch (p) {
+    case KernelPath::Avx512: return "avx512";
+    case KernelPath::Fma: return "fma";
+    case KernelPath::Generic: return "generic";
+  }
+  return "generic";
 }
 
-bool simd_kernel_active() {
-#ifdef MAGSIM_AVX512_KERNEL
-  return cpu_has_avx512() && !portable_kernel_forced() &&
-         g_simd_enabled.load(std::memory_order_relaxed);
-#else
-  return false;
-#endif
+KernelPath kernel_path() {
+  return slower(slower(cpu_best(), env_limit()), g_limit.load(std::memory_order_relaxed));
 }
+
+void limit_kernel_path(KernelPath fastest) { g_limit = fastest; }
+
+void enable_simd_kernel(bool on) { limit_kernel_path(on ? KernelPath::Avx512 : KernelPath::Fma); }
+
+bool portable_kernel_forced() { return env_limit() != KernelPath::Avx512; }
+
+bool simd_kernel_active() { return kernel_path() == KernelPath::Avx512; }
 
 void sum_pairs(const SourceView& v, const Target& t, double eps2, PairTerms terms, double* H,
                double* J) {

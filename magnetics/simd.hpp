@@ -1,12 +1,14 @@
 // magnetics/simd.hpp — internal: the lane operations of the field kernels, in two sets that
 // give the same bits: portable lanes (PD, PF: GCC generic vectors that the compiler splits into
 // the CPU's width) and AVX-512 registers (__m512d, __m512). A kernel body is written once over
-// these names (pair_sweep.inc, far_block.inc) and compiled for both sets, so its result does
-// not depend on the CPU. Every operation is element-wise IEEE (+, −, ×, ÷, √, max, compare,
-// select), FMA is never used ("mul_add" rounds twice), sums across lanes follow one tree
-// (hsum), and 1/√q is computed the same way on both (inv_sqrt). Double kernels run 8 lanes,
-// float kernels 16, whatever the hardware width. Include only from magnetics/*.cpp, after
-// field_kernel.hpp.
+// these names (pair_sweep.inc, far_block.inc) and compiled for both sets (the portable lanes
+// twice: for any x86-64 and for AVX2+FMA), so its result does not depend on the CPU. Every
+// operation is element-wise IEEE and correctly rounded (+, −, ×, ÷, √, fused a·b + c, max,
+// compare, select), sums across lanes follow one tree (hsum), and 1/√q is 1 ÷ √q on both.
+// mul_add is always fused, never contracted by the compiler: one rounding on every CPU, in
+// the FMA instruction or, on a CPU without it, in soft_fma's exact emulation below. Double
+// kernels run 8 lanes, float kernels 16, whatever the hardware width. Include only from
+// magnetics/*.cpp, after field_kernel.hpp.
 #pragma once
 
 #include "magnetics/field_kernel.hpp"
@@ -99,14 +101,158 @@ inline PF ld(const float* p, PF) {
     M r;                                                                                     \
     for (int k = 0; k < N; ++k) r.m[k] = static_cast<std::size_t>(k) < n ? -1 : 0;           \
     return r;                                                                                \
-  }                                                                                          \
-  /* a·b + c and c − a·b, rounded twice (never fused); a·x + b·y + c·z left to right */      \
-  inline P mul_add(P a, P b, P c) { return add(mul(a, b), c); }                              \
-  inline P neg_mul_add(P a, P b, P c) { return sub(c, mul(a, b)); }                          \
-  inline P dot3(P a, P b, P c, P x, P y, P z) { return add(add(mul(a, x), mul(b, y)), mul(c, z)); }
+  }
 MAGSIM_PORTABLE_OPS(PD, MD, double, 8)
 MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 #undef MAGSIM_PORTABLE_OPS
+
+// ---- fused a·b + c of the portable lanes -------------------------------------------------
+//
+// Two sets of mul_add, neg_mul_add and dot3 with the same bits; each instance of a kernel
+// body picks one with a using-directive before its #include (pair_kernel.cpp,
+// barnes_hut_far.cpp). The header cannot pick by itself: GCC 12 does not change __FMA__
+// inside a `#pragma GCC target` region, and these functions are defined outside any.
+//   fused_hw:   __builtin_fma per lane, one FMA instruction per register in the AVX2+FMA
+//               instance (a call to glibc's fma, ~200× slower in software, elsewhere);
+//   fused_soft: for the instance of a CPU without FMA: soft_fma below, in +, −, × and bit
+//               operations that SSE2 vectorizes (__builtin_fma where the whole build has FMA).
+
+/// Correctly rounded (round-to-nearest-even) a·b + c lane by lane, bit for bit the FMA
+/// instruction's result, from element-wise +, −, ×: no FMA instruction needed.
+namespace soft_fma {
+
+/// s + e = x + y exactly, s = RN(x + y) (Knuth's TwoSum; exact unless x + y overflows)
+inline void two_sum(VecD8 x, VecD8 y, VecD8& s, VecD8& e) {
+  s = x + y;
+  const VecD8 yv = s - x;
+  e = (x - (s - yv)) + (y - yv);
+}
+
+/// x = hi + lo, each with at most 26 significant bits (Veltkamp's splitting, C = 2^27 + 1;
+/// exact while C·x does not overflow)
+inline void split(VecD8 x, VecD8& hi, VecD8& lo) {
+  const VecD8 g = x * 134217729.0;
+  hi = g - (g - x);
+  lo = x - hi;
+}
+
+/// RO(s + e), rounded to odd (s = RN(s + e), e its error from two_sum): s where e = 0 or
+/// s's last significand bit is 1, else s's neighbour toward e (± 1 on the bit pattern of s,
+/// which is nonzero since a sum that rounds to 0 is exact). A NaN e (inf or NaN inputs)
+/// changes nothing. Sign tests by floating compare: SSE2 has no 64-bit integer compare.
+inline VecD8 round_odd(VecD8 s, VecD8 e) {
+  const VecI64x8 bits = __builtin_bit_cast(VecI64x8, s);
+  const VecI64x8 same = ((e > 0.0) & (s > 0.0)) | ((e < 0.0) & (s < 0.0));
+  const VecI64x8 opposite = ((e > 0.0) & (s < 0.0)) | ((e < 0.0) & (s > 0.0));
+  const VecI64x8 even = (bits & 1) ^ 1;
+  const VecI64x8 r = bits + (even & same) - (even & opposite);
+  return __builtin_bit_cast(VecD8, r);
+}
+
+// Double lanes with every input nonzero in [2^-450, 2^450] (kLo, kHi): C·x stays below 2^478,
+// a·b below 2^900, and every term of the algorithm is a multiple of 2^-1004 (ulp(a) ulp(b)
+// ≥ 2^-502 · 2^-502, ulp(c) ≥ 2^-502), so no step overflows or leaves the normal range and
+// the proof for an unbounded exponent applies.
+constexpr double kLo = 0x1p-450, kHi = 0x1p450;
+
+/// Scalar std::fma in the lanes where ok is 0 (inputs out of range, inf or NaN: rare)
+[[gnu::noinline, gnu::cold]] inline void fma_lanes(VecD8& r, const VecI64x8& ok, const VecD8& a,
+                                                  const VecD8& b, const VecD8& c) {
+  for (int k = 0; k < 8; ++k)
+    if (ok[k] == 0) r[k] = std::fma(a[k], b[k], c[k]);
+}
+
+/// RN(a·b + c) in double lanes (Boldo & Melquiond, "Emulation of FMA and correctly rounded
+/// sums: proved algorithms using rounding to odd", IEEE TC 2008): a·b = uh + ul exactly
+/// (Dekker's product on Veltkamp's halves), th + tl = c + uh (TwoSum), v = RO(tl + ul),
+/// result RN(th + v). Lanes with a or b zero: a·b + c as two operations (the product ±0 is
+/// exact); with c zero and a·b not: RN(a·b); out of range: std::fma. An exact cancellation
+/// gives th = +0 and v = ±0, so +0 as RN has it.
+[[gnu::always_inline]] inline VecD8 fma(VecD8 a, VecD8 b, VecD8 c) {
+  const VecD8 uh = a * b;
+  VecD8 ah, al, bh, bl;
+  split(a, ah, al);
+  split(b, bh, bl);
+  const VecD8 ul = (((ah * bh - uh) + ah * bl) + al * bh) + al * bl;
+  VecD8 th, tl, s, e;
+  two_sum(c, uh, th, tl);
+  two_sum(tl, ul, s, e);
+  const VecD8 r = th + round_odd(s, e);
+  const VecI64x8 zero_ab = (a == 0.0) | (b == 0.0), zero_c = c == 0.0;
+  const VecI64x8 abs_mask = ~(VecI64x8{} + INT64_MIN);
+  const auto in = [&](VecD8 x) {
+    const VecD8 ax = __builtin_bit_cast(VecD8, __builtin_bit_cast(VecI64x8, x) & abs_mask);
+    return (ax >= kLo) & (ax <= kHi);
+  };
+  const VecI64x8 ok = zero_ab | zero_c | (in(a) & in(b) & in(c));
+  VecD8 out = zero_ab ? uh + c : (zero_c ? uh : r);
+  std::int64_t all = -1;
+  for (int k = 0; k < 8; ++k) all &= ok[k];
+  if (all == 0) fma_lanes(out, ok, a, b, c);
+  return out;
+}
+
+/// RN(a·b + c) in float lanes: RN_float(RO_double(a·b + c)). a·b is exact in double (24 + 24
+/// bits, exponents far inside double's range), TwoSum of it and c is exact, and rounding to
+/// odd in 53 ≥ 24 + 2 bits and then to nearest in 24 rounds once (Boldo & Melquiond, as
+/// above), subnormal and overflowing float results included. Plain RN_double instead would
+/// round twice. Zeros, infs and NaNs follow IEEE in every step: no special lanes.
+inline VecD8 fma_f_in_double(VecD8 a, VecD8 b, VecD8 c) {
+  VecD8 s, e;
+  two_sum(a * b, c, s, e);
+  return round_odd(s, e);
+}
+[[gnu::always_inline]] inline VecF16 fma(VecF16 a, VecF16 b, VecF16 c) {
+  VecF8 h[3][2];
+  std::memcpy(h[0], &a, sizeof a);
+  std::memcpy(h[1], &b, sizeof b);
+  std::memcpy(h[2], &c, sizeof c);
+  VecF8 r[2];
+  for (int i = 0; i < 2; ++i) {
+    const VecD8 x = fma_f_in_double(__builtin_convertvector(h[0][i], VecD8),
+                                    __builtin_convertvector(h[1][i], VecD8),
+                                    __builtin_convertvector(h[2][i], VecD8));
+    r[i] = __builtin_convertvector(x, VecF8);
+  }
+  VecF16 out;
+  std::memcpy(&out, r, sizeof out);
+  return out;
+}
+
+}  // namespace soft_fma
+
+// a·b + c and c − a·b fused (one rounding); a·x + b·y + c·z as fma(c, z, fma(b, y, a·x))
+#define MAGSIM_FUSED_OPS(P)                                                                  \
+  inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
+  inline P dot3(P a, P b, P c, P x, P y, P z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
+
+namespace fused_hw {
+inline PD mul_add(PD a, PD b, PD c) {
+  PD r;
+  for (int k = 0; k < 8; ++k) r.v[k] = __builtin_fma(a.v[k], b.v[k], c.v[k]);
+  return r;
+}
+inline PF mul_add(PF a, PF b, PF c) {
+  PF r;
+  for (int k = 0; k < 16; ++k) r.v[k] = __builtin_fmaf(a.v[k], b.v[k], c.v[k]);
+  return r;
+}
+MAGSIM_FUSED_OPS(PD)
+MAGSIM_FUSED_OPS(PF)
+}  // namespace fused_hw
+
+namespace fused_soft {
+#ifdef __FMA__
+using fused_hw::mul_add;
+#else
+inline PD mul_add(PD a, PD b, PD c) { return PD{soft_fma::fma(a.v, b.v, c.v)}; }
+inline PF mul_add(PF a, PF b, PF c) { return PF{soft_fma::fma(a.v, b.v, c.v)}; }
+#endif
+MAGSIM_FUSED_OPS(PD)
+MAGSIM_FUSED_OPS(PF)
+}  // namespace fused_soft
+
+#undef MAGSIM_FUSED_OPS
 
 /// The portable lane set of a scalar type (a kernel body reads LaneOf<T>::V)
 template <class T>
@@ -126,16 +272,11 @@ inline V cst(double x) {
   return splat(V(), x);
 }
 
-/// 1/√q in the lanes of m, 0 elsewhere; see inv_sqrt for __m512d
+/// 1/√q as 1 ÷ √q (two correctly rounded steps) in the lanes of m, 0 elsewhere
 inline PD inv_sqrt(MD m, PD q) {
-  VecF8 f = __builtin_convertvector(q.v, VecF8);
-  VecF8 s;
-  for (int k = 0; k < 8; ++k) s[k] = std::sqrt(f[k]);
-  f = 1.0f / s;
-  PD y{__builtin_convertvector(f, VecD8)};
-  const VecD8 h = 0.5 * q.v;
-  for (int it = 0; it < 2; ++it) y.v = y.v * (1.5 - h * (y.v * y.v));
-  return keep(m, y);
+  PD s;
+  for (int k = 0; k < 8; ++k) s.v[k] = std::sqrt(q.v[k]);
+  return keep(m, PD{1.0 / s.v});
 }
 inline PF inv_sqrt(MF m, PF q) {
   PF s;
@@ -230,27 +371,19 @@ template <>
 inline V8 cst<V8>(double x) { return _mm512_set1_pd(x); }
 template <>
 inline V16 cst<V16>(double x) { return _mm512_set1_ps(static_cast<float>(x)); }
-// mul_add, neg_mul_add, dot3 as for the portable lanes (never fused)
-#define MAGSIM_AVX_HELPERS(V)                                                       \
-  inline V mul_add(V a, V b, V c) { return add(mul(a, b), c); }                     \
-  inline V neg_mul_add(V a, V b, V c) { return sub(c, mul(a, b)); }                 \
-  inline V dot3(V a, V b, V c, V x, V y, V z) { return add(add(mul(a, x), mul(b, y)), mul(c, z)); }
-MAGSIM_AVX_HELPERS(V8)
-MAGSIM_AVX_HELPERS(V16)
-#undef MAGSIM_AVX_HELPERS
+// mul_add, neg_mul_add, dot3 as for the portable lanes (fused: one rounding)
+inline V8 mul_add(V8 a, V8 b, V8 c) { return _mm512_fmadd_pd(a, b, c); }
+inline V16 mul_add(V16 a, V16 b, V16 c) { return _mm512_fmadd_ps(a, b, c); }
+inline V8 neg_mul_add(V8 a, V8 b, V8 c) { return _mm512_fnmadd_pd(a, b, c); }
+inline V16 neg_mul_add(V16 a, V16 b, V16 c) { return _mm512_fnmadd_ps(a, b, c); }
+inline V8 dot3(V8 a, V8 b, V8 c, V8 x, V8 y, V8 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
+inline V16 dot3(V16 a, V16 b, V16 c, V16 x, V16 y, V16 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
 
-/// 1/√q in the lanes of k (0 elsewhere), the same bits as the portable lanes: a float start
-/// 1/√(float q) (correctly rounded steps: relative error < 1e-7), then two Newton steps in
-/// double, y ← y (3/2 − (q/2) y²), each squaring the error (< 1e-28 after the second), so
-/// that the result is within a few ulp of 1/√q. (q must lie in float's normal range, as
-/// every separation the kernels see does: 1e-19 … 1e19 m².)
+/// 1/√q as 1 ÷ √q in the lanes of k (0 elsewhere), the same bits as the portable lanes: two
+/// correctly rounded steps, within 1.5 ulp of 1/√q (cheaper here than a float start and two
+/// Newton steps, and exact-rounding on every CPU)
 inline V8 inv_sqrt(__mmask8 k, V8 q) {
-  const __m256 qf = _mm512_maskz_cvtpd_ps(0xff, q);
-  const __m256 yf = _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(qf));
-  V8 y = _mm512_maskz_cvtps_pd(0xff, yf);
-  const V8 h = mul(_mm512_set1_pd(0.5), q), c = _mm512_set1_pd(1.5);
-  for (int it = 0; it < 2; ++it) y = mul(y, sub(c, mul(h, mul(y, y))));
-  return keep(k, y);
+  return _mm512_maskz_div_pd(k, _mm512_set1_pd(1.0), _mm512_maskz_sqrt_pd(k, q));
 }
 /// 1/√q in float, correctly rounded steps (√ then ÷) in the lanes of k, 0 elsewhere
 inline V16 inv_sqrt(__mmask16 k, V16 q) {

@@ -42,14 +42,14 @@ std::string run_hash(const char* name, long steps, engine::SpaceKind space, int 
 
 // The one golden table (tests/engine/golden_hashes.txt): each registry scene after 100 rigid
 // steps ends in one state hash on every x86-64 CPU and path — native or portable build,
-// Release, Debug or ASan+UBSan, AVX-512 field kernels or the portable ones, any thread
-// count, whichever libm variants glibc picks — because nothing that reaches the state
-// depends on them: no FMA contraction, no Eigen vectorization, field kernels with a fixed
-// lane count and sum tree (magnetics/simd.hpp), and deterministic transcendental functions
-// (magnetics/det_math.hpp). This test checks the build it is in with the kernels the CPU
-// picks, and again with the portable kernels forced; tools/scripts/golden_check.py runs
-// magsim-scene under the other paths (MAGSIM_KERNEL=portable, GLIBC_TUNABLES, 2 threads,
-// the portable and -march=x86-64-v3/-v2 builds). A change meant to alter results (a new
+// Release, Debug or ASan+UBSan, AVX-512, FMA or generic field kernels, any thread count,
+// whichever libm variants glibc picks — because nothing that reaches the state depends on
+// them: no FMA contraction by the compiler, no Eigen vectorization, field kernels with a
+// fixed lane count and sum tree whose multiply-adds are always fused (magnetics/simd.hpp),
+// and deterministic transcendental functions (magnetics/det_math.hpp). This test checks the
+// build it is in with the kernels the CPU picks, and again on each slower path;
+// tools/scripts/golden_check.py runs magsim-scene under the other paths (MAGSIM_KERNEL,
+// GLIBC_TUNABLES, 2 threads, the portable and -march=x86-64-v3/-v2 builds). A change meant to alter results (a new
 // default, a fixed bug) says so in its commit and copies the "now" hashes printed here into
 // the table; a refactor leaves them as they are.
 namespace {
@@ -78,22 +78,24 @@ TEST_CASE("golden state hashes: the five registry scenes after 100 steps, one ha
           "[golden]") {
   const std::vector<Golden> table = golden_table();
   REQUIRE(table.size() == 5);
-  const bool simd = mag::detail::simd_kernel_active();
-  for (const Golden& g : table) {
-    const std::string now = run_hash(g.scene.c_str(), 100, engine::SpaceKind::SweepAndPrune);
-    INFO(g.scene << " (" << (simd ? "AVX-512" : "portable") << " kernels): now " << now
-                 << ", stored " << g.hash);
-    CHECK(now == g.hash);
-  }
-  if (simd) {  // the same with the portable kernels on this CPU
-    mag::detail::enable_simd_kernel(false);
+  using mag::detail::KernelPath;
+  const KernelPath best = mag::detail::kernel_path();
+  for (KernelPath p : {KernelPath::Avx512, KernelPath::Fma, KernelPath::Generic}) {
+    if (p < best) continue;  // a path this CPU or build does not have
+    mag::detail::limit_kernel_path(p);
     for (const Golden& g : table) {
+      // the generic kernels emulate each fused multiply-add (about 40x slower): the two
+      // small scenes here, every scene in .ci/run (golden_check.py --variants generic)
+      if (p == KernelPath::Generic && best != KernelPath::Generic && g.scene != "balls_up" &&
+          g.scene != "crystal_balls")
+        continue;
       const std::string now = run_hash(g.scene.c_str(), 100, engine::SpaceKind::SweepAndPrune);
-      INFO(g.scene << " (portable kernels forced): now " << now << ", stored " << g.hash);
+      INFO(g.scene << " (" << mag::detail::kernel_path_name(mag::detail::kernel_path())
+                   << " kernels): now " << now << ", stored " << g.hash);
       CHECK(now == g.hash);
     }
-    mag::detail::enable_simd_kernel(true);
   }
+  mag::detail::limit_kernel_path(KernelPath::Avx512);
 }
 
 TEST_CASE("every broad phase (sap, hash, simple) gives the same state hash", "[golden]") {

@@ -91,6 +91,9 @@ TEST_CASE("step: same scene and options give the same state hash", "[step][deter
   SECTION("a changed magnetics option changes it") {
     SceneDesc s2 = s;
     s2.options.magnetics.dt = 1.2e-7;
+    // as above: this pile (eq. 4's realigned dynamics at 2x) flings ball_4 to 1390 m/s at
+    // step 145 with dt 1.2e-7; the section compares hashes only
+    s2.options.max_body_speed = 0;
     engine::Simulation c(s2);
     c.run(200);
     CHECK(c.state_hash() != a.state_hash());

@@ -133,8 +133,10 @@ TEST_CASE("Float pair kernel: softening, self and same-group exclusions as the d
   const detail::Target td{sb.x[self], sb.y[self], sb.z[self], double(self), 5.0, 0.0};
   const detail::TargetF tf{f[0][self], f[1][self], f[2][self], self, 5, 0.0f};
   for (double eps : {0.0, 2e-3}) {
-    for (bool simd : {true, false}) {
-      detail::enable_simd_kernel(simd);
+    for (detail::KernelPath path :
+         {detail::KernelPath::Avx512, detail::KernelPath::Fma, detail::KernelPath::Generic}) {
+      detail::limit_kernel_path(path);
+      const char* name = detail::kernel_path_name(detail::kernel_path());
       double Hd[3] = {}, Jd[6] = {}, Hf[3] = {}, Jf[6] = {};
       detail::sum_pairs(vd, td, eps * eps, detail::PairTerms::HJ, Hd, Jd);
       detail::sum_pairs_f32(vf, tf, static_cast<float>(eps * eps), detail::PairTerms::HJ, Hf, Jf);
@@ -150,8 +152,8 @@ TEST_CASE("Float pair kernel: softening, self and same-group exclusions as the d
       // the H-only sweep gives the same H
       double Hh[3] = {};
       detail::sum_pairs_f32(vf, tf, static_cast<float>(eps * eps), detail::PairTerms::H, Hh, nullptr);
-      detail::enable_simd_kernel(true);
-      INFO("ε = " << eps << (simd ? " AVX-512" : " portable") << ": |ΔH|/|H| "
+      detail::limit_kernel_path(detail::KernelPath::Avx512);
+      INFO("ε = " << eps << " " << name << ": |ΔH|/|H| "
                   << std::sqrt(dh / nh) << ", |ΔJ|/|J| " << std::sqrt(dj / nj));
       CHECK(std::sqrt(dh / nh) <= 1e-5);
       CHECK(std::sqrt(dj / nj) <= 1e-5);

@@ -124,9 +124,9 @@ TEST_CASE("bounded pairs: every kernel agrees on an overlapping pile", "[field][
   std::vector<Vec3> Hs, Hp, Hu;
   std::vector<Mat3> Js, Jp, Ju;
   compute_fields(s, d, &Hs, &Js, &ws);
-  detail::enable_simd_kernel(false);
+  detail::limit_kernel_path(detail::KernelPath::Generic);  // the slowest path: no FMA unit
   compute_fields(s, d, &Hp, &Jp, &ws);
-  detail::enable_simd_kernel(true);
+  detail::limit_kernel_path(detail::KernelPath::Avx512);
   FieldOptions u = d;
   u.bounded_pairs = false;
   compute_fields(s, u, &Hu, &Ju, &ws);

@@ -108,8 +108,8 @@ inline MomentSet fcc_pile(int n) {
 }
 
 /// Says so in the test output when this CPU has no AVX-512 (or it is switched off): then a
-/// SIMD-vs-portable comparison runs the portable loops twice and proves nothing about the
-/// AVX-512 kernels. Call at the top of such a test.
+/// SIMD-vs-portable comparison compares the FMA or generic path with itself and the slower
+/// ones, and proves nothing about the AVX-512 kernels. Call at the top of such a test.
 #define MAGSIM_NOTE_IF_NO_SIMD()                                                              \
   do {                                                                                      \
     if (!magsim::mag::detail::simd_kernel_active())                                         \

@@ -292,6 +292,7 @@ int main(int argc, char** argv) {
 
   json out;
   out["simd_kernel"] = mag::detail::simd_kernel_active();
+  out["kernel_path"] = mag::detail::kernel_path_name(mag::detail::kernel_path());
   out["repeat"] = repeat;
   out["stat"] = stat;
   out["clock"] = clock;
@@ -300,8 +301,9 @@ int main(int argc, char** argv) {
   out["bh_near"] = bh_near;
   out["bh_far"] = bh_far;
   out["results"] = json::array();
-  std::printf("# AVX-512 kernel: %s; %s of %d repeats; pairs/s = targets × sources / time\n",
-              mag::detail::simd_kernel_active() ? "yes" : "no", g_use_min ? "min" : "median", repeat);
+  std::printf("# AVX-512 kernel: %s (path %s); %s of %d repeats; pairs/s = targets × sources / time\n",
+              mag::detail::simd_kernel_active() ? "yes" : "no",
+              mag::detail::kernel_path_name(mag::detail::kernel_path()), g_use_min ? "min" : "median", repeat);
   for (const std::string& layout : layouts) {
     if (layout != "pile" && layout != "cloud" && layout != "sheet") {
       std::fprintf(stderr, "unknown layout %s (pile, cloud, sheet)\n", layout.c_str());

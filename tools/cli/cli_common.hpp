@@ -114,17 +114,19 @@ inline std::string omp_num_threads_error() {
 
 /// The --help line of both programs on MAGSIM_KERNEL (checked by magsim_kernel_error below).
 inline constexpr const char* kMagsimKernelHelp =
-    "MAGSIM_KERNEL=portable: the portable field kernels even on a CPU with AVX-512 (unset or "
-    "auto: AVX-512 where the CPU has it; other values are refused).";
+    "MAGSIM_KERNEL=portable: the field kernels of a CPU without AVX-512 even on one with it; "
+    "generic: those of a CPU without FMA either (slow); unset or auto: the fastest the CPU has "
+    "(every path gives the same bits; other values are refused).";
 
-/// "" when MAGSIM_KERNEL is unset, "auto" or "portable" (magnetics/field_kernel.hpp: the
-/// portable field kernels even on a CPU with AVX-512), else the one-line reason. The library
-/// takes any other value as "auto"; both programs refuse it, so that a typo cannot pass for
-/// the switch.
+/// "" when MAGSIM_KERNEL is unset, "auto", "portable" or "generic" (magnetics/field_kernel.hpp:
+/// kernel_path), else the one-line reason. The library takes any other value as "auto"; both
+/// programs refuse it, so that a typo cannot pass for the switch.
 inline std::string magsim_kernel_error() {
   const char* v = std::getenv("MAGSIM_KERNEL");
-  if (!v || std::strcmp(v, "auto") == 0 || std::strcmp(v, "portable") == 0) return {};
-  return "MAGSIM_KERNEL='" + one_line(v) + "': must be auto or portable, or unset";
+  if (!v) return {};
+  for (const char* ok : {"auto", "portable", "generic"})
+    if (std::strcmp(v, ok) == 0) return {};
+  return "MAGSIM_KERNEL='" + one_line(v) + "': must be auto, portable or generic, or unset";
 }
 
 // ---- flag validators ---------------------------------------------------------------------

@@ -6,10 +6,14 @@ Runs each registry scene for 100 rigid steps (magsim-scene SCENE --steps 100 --t
 summary.json's state_hash with the one golden table (tests/engine/golden_hashes.txt):
 
   plain        the binary as it is (AVX-512 field kernels where the CPU has them)
-  portable     MAGSIM_KERNEL=portable: the kernels a CPU without AVX-512 runs
+  portable     MAGSIM_KERNEL=portable: the kernels a CPU with AVX2+FMA but no AVX-512 runs
   sse2-libm    GLIBC_TUNABLES=glibc.cpu.hwcaps=-FMA,-AVX2: glibc's libm takes the variants
-               of a CPU without FMA or AVX2 (the engine must not reach libm at all)
+               of a CPU without FMA or AVX2 (the engine must not reach libm's rounding)
   2-threads    --threads 2 instead of 1
+  generic      MAGSIM_KERNEL=generic: the kernels of a CPU without FMA (the fused
+               multiply-add emulated exactly, about 40x slower: only the scenes of
+               SLOW_SCENES unless --scenes names others)
+  no-fma       generic with the sse2-libm tunables, as on a CPU without FMA (likewise)
 
 A binary built with -DMAGSIM_NATIVE=OFF is the portable build; one built with
 -DMAGSIM_MARCH=x86-64-v3 (or -v2) is a native build for a CPU with AVX2 and FMA (or
@@ -34,7 +38,10 @@ VARIANTS = {
     "portable": ({"MAGSIM_KERNEL": "portable"}, []),
     "sse2-libm": ({"GLIBC_TUNABLES": "glibc.cpu.hwcaps=-FMA,-AVX2"}, []),
     "2-threads": ({}, ["--threads", "2"]),
+    "generic": ({"MAGSIM_KERNEL": "generic"}, []),
+    "no-fma": ({"MAGSIM_KERNEL": "generic", "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-FMA,-AVX2"}, []),
 }
+SLOW_SCENES = ["balls_up", "crystal_balls"]
 
 
 def golden_table():
@@ -89,7 +96,10 @@ def main():
     for b in bins:
         for v in variants:
             env_extra, flags = VARIANTS[v]
-            for s in scenes:
+            todo = scenes
+            if v in ("generic", "no-fma") and not a.scenes:
+                todo = [s for s in scenes if s in SLOW_SCENES]
+            for s in todo:
                 h, err = run_hash(b, s, env_extra, flags)
                 ok = h is not None and h == table.get(s)
                 passed += ok

@@ -98,7 +98,7 @@ TEST_CASE("OMP_NUM_THREADS: above 4x the cores or not a thread count is refused 
   CHECK(magsim::test::run_command("OMP_NUM_THREADS=1 " + std::string(MAGSOLVE_BIN), example("touching_spheres.json")).code == 0);
 }
 
-TEST_CASE("MAGSIM_KERNEL: only auto or portable is taken, anything else is refused in one line, exit 1", "[reliability]") {
+TEST_CASE("MAGSIM_KERNEL: only auto, portable or generic is taken, anything else is refused in one line, exit 1", "[reliability]") {
   for (const char* value : {"Portable", "avx512", ""}) {
     for (const bool solver : {true, false}) {
       const std::string env = std::string("MAGSIM_KERNEL='") + value + "' ";
@@ -108,11 +108,11 @@ TEST_CASE("MAGSIM_KERNEL: only auto or portable is taken, anything else is refus
                                                                      tmp("kernel"));
       INFO((solver ? "magsolve" : "magsim-scene") << " MAGSIM_KERNEL='" << value << "': exit " << r.code << ": " << r.out);
       CHECK(r.code == 1);
-      CHECK(r.out.find("MAGSIM_KERNEL='" + std::string(value) + "': must be auto or portable") != std::string::npos);
+      CHECK(r.out.find("MAGSIM_KERNEL='" + std::string(value) + "': must be auto, portable or generic") != std::string::npos);
       CHECK(lines(r.out) == 1);
     }
   }
-  for (const char* value : {"auto", "portable"})
+  for (const char* value : {"auto", "portable", "generic"})
     CHECK(magsim::test::run_command(std::string("MAGSIM_KERNEL=") + value + " " + MAGSOLVE_BIN,
                                     example("touching_spheres.json")).code == 0);
 }
