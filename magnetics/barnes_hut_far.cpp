@@ -77,7 +77,7 @@ using LaneOf = detail::simd::PortableLaneOf<T>;
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace fma {
-using namespace detail::simd::fused_hw;  // one FMA instruction per register
+using namespace detail::simd::fused_avx2;  // FMA instructions on the register halves
 template <class T>
 using LaneOf = detail::simd::PortableLaneOf<T>;
 #include "magnetics/far_block.inc"

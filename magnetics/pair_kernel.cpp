@@ -75,7 +75,7 @@ using LaneOf = simd::PortableLaneOf<T>;
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace fma {
-using namespace simd::fused_hw;  // one FMA instruction per register
+using namespace simd::fused_avx2;  // FMA instructions on the register halves
 template <class T>
 using LaneOf = simd::PortableLaneOf<T>;
 #include "magnetics/pair_sweep.inc"

@@ -17,6 +17,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#ifdef MAGSIM_FMA_KERNEL
+#include <immintrin.h>
+#endif
 
 namespace magsim::mag::detail::simd {
 
@@ -112,10 +115,11 @@ MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 // body picks one with a using-directive before its #include (pair_kernel.cpp,
 // barnes_hut_far.cpp). The header cannot pick by itself: GCC 12 does not change __FMA__
 // inside a `#pragma GCC target` region, and these functions are defined outside any.
-//   fused_hw:   __builtin_fma per lane, one FMA instruction per register in the AVX2+FMA
-//               instance (a call to glibc's fma, ~200× slower in software, elsewhere);
+//   fused_avx2: the AVX2+FMA instance's: FMA intrinsics on the register halves (inside a
+//               target region, so only that instance can inline them);
+//   fused_hw:   __builtin_fma per lane (a call to glibc's fma where the build has no FMA);
 //   fused_soft: for the instance of a CPU without FMA: soft_fma below, in +, −, × and bit
-//               operations that SSE2 vectorizes (__builtin_fma where the whole build has FMA).
+//               operations that SSE2 vectorizes (fused_hw where the whole build has FMA).
 
 /// Correctly rounded (round-to-nearest-even) a·b + c lane by lane, bit for bit the FMA
 /// instruction's result, from element-wise +, −, ×: no FMA instruction needed.
@@ -251,6 +255,39 @@ inline PF mul_add(PF a, PF b, PF c) { return PF{soft_fma::fma(a.v, b.v, c.v)}; }
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
 }  // namespace fused_soft
+
+#ifdef MAGSIM_FMA_KERNEL
+// fused_avx2: the AVX2+FMA instance's set, two FMA instructions per lane set. Written with
+// intrinsics on the register halves: GCC 12 leaves fused_hw's per-lane loop scalar there.
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+namespace fused_avx2 {
+typedef double VecD4 __attribute__((vector_size(32)));
+inline PD mul_add(PD a, PD b, PD c) {
+  const VecD4 lo = (VecD4)_mm256_fmadd_pd((__m256d)__builtin_shufflevector(a.v, a.v, 0, 1, 2, 3),
+                                          (__m256d)__builtin_shufflevector(b.v, b.v, 0, 1, 2, 3),
+                                          (__m256d)__builtin_shufflevector(c.v, c.v, 0, 1, 2, 3));
+  const VecD4 hi = (VecD4)_mm256_fmadd_pd((__m256d)__builtin_shufflevector(a.v, a.v, 4, 5, 6, 7),
+                                          (__m256d)__builtin_shufflevector(b.v, b.v, 4, 5, 6, 7),
+                                          (__m256d)__builtin_shufflevector(c.v, c.v, 4, 5, 6, 7));
+  return PD{__builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7)};
+}
+inline PF mul_add(PF a, PF b, PF c) {
+  const VecF8 lo = (VecF8)_mm256_fmadd_ps(
+      (__m256)__builtin_shufflevector(a.v, a.v, 0, 1, 2, 3, 4, 5, 6, 7),
+      (__m256)__builtin_shufflevector(b.v, b.v, 0, 1, 2, 3, 4, 5, 6, 7),
+      (__m256)__builtin_shufflevector(c.v, c.v, 0, 1, 2, 3, 4, 5, 6, 7));
+  const VecF8 hi = (VecF8)_mm256_fmadd_ps(
+      (__m256)__builtin_shufflevector(a.v, a.v, 8, 9, 10, 11, 12, 13, 14, 15),
+      (__m256)__builtin_shufflevector(b.v, b.v, 8, 9, 10, 11, 12, 13, 14, 15),
+      (__m256)__builtin_shufflevector(c.v, c.v, 8, 9, 10, 11, 12, 13, 14, 15));
+  return PF{__builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)};
+}
+MAGSIM_FUSED_OPS(PD)
+MAGSIM_FUSED_OPS(PF)
+}  // namespace fused_avx2
+#pragma GCC pop_options
+#endif
 
 #undef MAGSIM_FUSED_OPS
 
