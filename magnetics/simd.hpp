@@ -225,7 +225,14 @@ inline VecD8 fma_f_in_double(VecD8 a, VecD8 b, VecD8 c) {
 
 }  // namespace soft_fma
 
-// a·b + c and c − a·b fused (one rounding); a·x + b·y + c·z as fma(c, z, fma(b, y, a·x))
+/// Float lanes: a·b + c rounded twice, on every path. The float kernels (Barnes–Hut's near
+/// and far fields) are approximations to 1e-5 already, and fused they compiled to twice the
+/// spills in the AVX2+FMA instance (sakura_tree's T_i + T_f 2x); unfused they give the same
+/// bits everywhere as before.
+inline PF unfused_mul_add(PF a, PF b, PF c) { return PF{a.v * b.v + c.v}; }
+
+// a·b + c and c − a·b fused (one rounding; float: see unfused_mul_add); a·x + b·y + c·z as
+// mul_add(c, z, mul_add(b, y, a·x))
 #define MAGSIM_FUSED_OPS(P)                                                                  \
   inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
   inline P dot3(P a, P b, P c, P x, P y, P z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
@@ -236,11 +243,7 @@ inline PD mul_add(PD a, PD b, PD c) {
   for (int k = 0; k < 8; ++k) r.v[k] = __builtin_fma(a.v[k], b.v[k], c.v[k]);
   return r;
 }
-inline PF mul_add(PF a, PF b, PF c) {
-  PF r;
-  for (int k = 0; k < 16; ++k) r.v[k] = __builtin_fmaf(a.v[k], b.v[k], c.v[k]);
-  return r;
-}
+inline PF mul_add(PF a, PF b, PF c) { return unfused_mul_add(a, b, c); }
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
 }  // namespace fused_hw
@@ -250,7 +253,7 @@ namespace fused_soft {
 using fused_hw::mul_add;
 #else
 inline PD mul_add(PD a, PD b, PD c) { return PD{soft_fma::fma(a.v, b.v, c.v)}; }
-inline PF mul_add(PF a, PF b, PF c) { return PF{soft_fma::fma(a.v, b.v, c.v)}; }
+inline PF mul_add(PF a, PF b, PF c) { return unfused_mul_add(a, b, c); }
 #endif
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
@@ -272,17 +275,7 @@ inline PD mul_add(PD a, PD b, PD c) {
                                           (__m256d)__builtin_shufflevector(c.v, c.v, 4, 5, 6, 7));
   return PD{__builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7)};
 }
-inline PF mul_add(PF a, PF b, PF c) {
-  const VecF8 lo = (VecF8)_mm256_fmadd_ps(
-      (__m256)__builtin_shufflevector(a.v, a.v, 0, 1, 2, 3, 4, 5, 6, 7),
-      (__m256)__builtin_shufflevector(b.v, b.v, 0, 1, 2, 3, 4, 5, 6, 7),
-      (__m256)__builtin_shufflevector(c.v, c.v, 0, 1, 2, 3, 4, 5, 6, 7));
-  const VecF8 hi = (VecF8)_mm256_fmadd_ps(
-      (__m256)__builtin_shufflevector(a.v, a.v, 8, 9, 10, 11, 12, 13, 14, 15),
-      (__m256)__builtin_shufflevector(b.v, b.v, 8, 9, 10, 11, 12, 13, 14, 15),
-      (__m256)__builtin_shufflevector(c.v, c.v, 8, 9, 10, 11, 12, 13, 14, 15));
-  return PF{__builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)};
-}
+inline PF mul_add(PF a, PF b, PF c) { return unfused_mul_add(a, b, c); }
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
 }  // namespace fused_avx2
@@ -410,9 +403,9 @@ template <>
 inline V16 cst<V16>(double x) { return _mm512_set1_ps(static_cast<float>(x)); }
 // mul_add, neg_mul_add, dot3 as for the portable lanes (fused: one rounding)
 inline V8 mul_add(V8 a, V8 b, V8 c) { return _mm512_fmadd_pd(a, b, c); }
-inline V16 mul_add(V16 a, V16 b, V16 c) { return _mm512_fmadd_ps(a, b, c); }
+inline V16 mul_add(V16 a, V16 b, V16 c) { return add(mul(a, b), c); }  // unfused_mul_add
 inline V8 neg_mul_add(V8 a, V8 b, V8 c) { return _mm512_fnmadd_pd(a, b, c); }
-inline V16 neg_mul_add(V16 a, V16 b, V16 c) { return _mm512_fnmadd_ps(a, b, c); }
+inline V16 neg_mul_add(V16 a, V16 b, V16 c) { return sub(c, mul(a, b)); }
 inline V8 dot3(V8 a, V8 b, V8 c, V8 x, V8 y, V8 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
 inline V16 dot3(V16 a, V16 b, V16 c, V16 x, V16 y, V16 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
 
