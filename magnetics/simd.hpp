@@ -111,7 +111,7 @@ MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 
 // ---- fused a·b + c of the portable lanes -------------------------------------------------
 //
-// Two sets of mul_add, neg_mul_add and dot3 with the same bits; each instance of a kernel
+// Three sets of mul_add, neg_mul_add and dot3 with the same bits; each instance of a kernel
 // body picks one with a using-directive before its #include (pair_kernel.cpp,
 // barnes_hut_far.cpp). The header cannot pick by itself: GCC 12 does not change __FMA__
 // inside a `#pragma GCC target` region, and these functions are defined outside any.
