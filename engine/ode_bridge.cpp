@@ -120,6 +120,7 @@ struct OdeBridge::Impl {
   dSurfaceParameters rolling{};  ///< surface of contacts with a non-dynamic body
   dSurfaceParameters between{};  ///< surface of contacts between two dynamic bodies
   int max_contacts = 4;
+  bool skip_resting = false;  ///< this collide skips pairs of two resting bodies (some body sleeps)
   double damped_h = 0.0;  ///< the step length the damping factors are set for (s)
   double margin = 0.0;  ///< base speculative contact margin μ0 (m)
   std::vector<double> shape_margin;  ///< (nshape + 1) margin μ_s each geom is grown by now
@@ -306,7 +307,7 @@ struct OdeBridge::Impl {
     // a sleeping body (disabled: SimOptions::sleep) against a sleeping or non-dynamic one: no
     // row for ODE to solve; the step carries such pairs over (sleep.cpp)
     auto rests = [](const GeomTag* t, dGeomID g) { return !t->dynamic || !dBodyIsEnabled(dGeomGetBody(g)); };
-    if (self->model.options.sleep && rests(t1, o1) && rests(t2, o2)) return;
+    if (self->skip_resting && rests(t1, o1) && rests(t2, o2)) return;
     if (t1->shape > t2->shape) {
       std::swap(o1, o2);
       std::swap(t1, t2);
@@ -339,6 +340,8 @@ struct OdeBridge::Impl {
               std::vector<std::pair<int, int>>* joined) {
     ensure_thread_data();
     recs.clear();
+    skip_resting = model.options.sleep &&
+                   std::any_of(body.begin(), body.end(), [](dBodyID b) { return b && !dBodyIsEnabled(b); });
     dSpaceCollide(space, this, &near_callback);
     if (ground) dSpaceCollide2(reinterpret_cast<dGeomID>(space), ground, this, &near_callback);
     // fixed order, independent of the broad phase's internal lists: sorted by (a, b, k),
