@@ -196,42 +196,17 @@ constexpr double kLo = 0x1p-450, kHi = 0x1p450;
   return out;
 }
 
-/// RN(a·b + c) in float lanes: RN_float(RO_double(a·b + c)). a·b is exact in double (24 + 24
-/// bits, exponents far inside double's range), TwoSum of it and c is exact, and rounding to
-/// odd in 53 ≥ 24 + 2 bits and then to nearest in 24 rounds once (Boldo & Melquiond, as
-/// above), subnormal and overflowing float results included. Plain RN_double instead would
-/// round twice. Zeros, infs and NaNs follow IEEE in every step: no special lanes.
-inline VecD8 fma_f_in_double(VecD8 a, VecD8 b, VecD8 c) {
-  VecD8 s, e;
-  two_sum(a * b, c, s, e);
-  return round_odd(s, e);
-}
-[[gnu::always_inline]] inline VecF16 fma(VecF16 a, VecF16 b, VecF16 c) {
-  VecF8 h[3][2];
-  std::memcpy(h[0], &a, sizeof a);
-  std::memcpy(h[1], &b, sizeof b);
-  std::memcpy(h[2], &c, sizeof c);
-  VecF8 r[2];
-  for (int i = 0; i < 2; ++i) {
-    const VecD8 x = fma_f_in_double(__builtin_convertvector(h[0][i], VecD8),
-                                    __builtin_convertvector(h[1][i], VecD8),
-                                    __builtin_convertvector(h[2][i], VecD8));
-    r[i] = __builtin_convertvector(x, VecF8);
-  }
-  VecF16 out;
-  std::memcpy(&out, r, sizeof out);
-  return out;
-}
-
 }  // namespace soft_fma
 
 /// Float lanes: a·b + c rounded twice, on every path. The float kernels (Barnes–Hut's near
 /// and far fields) are approximations to 1e-5 already, and fused they compiled to twice the
 /// spills in the AVX2+FMA instance (sakura_tree's T_i + T_f 2x); unfused they give the same
 /// bits everywhere as before.
-inline PF unfused_mul_add(PF a, PF b, PF c) { return PF{a.v * b.v + c.v}; }
+namespace unfused_float {
+inline PF mul_add(PF a, PF b, PF c) { return PF{a.v * b.v + c.v}; }
+}  // namespace unfused_float
 
-// a·b + c and c − a·b fused (one rounding; float: see unfused_mul_add); a·x + b·y + c·z as
+// a·b + c and c − a·b fused (one rounding; float: see unfused_float); a·x + b·y + c·z as
 // mul_add(c, z, mul_add(b, y, a·x))
 #define MAGSIM_FUSED_OPS(P)                                                                  \
   inline P neg_mul_add(P a, P b, P c) { return mul_add(P{-a.v}, b, c); }                     \
@@ -243,7 +218,7 @@ inline PD mul_add(PD a, PD b, PD c) {
   for (int k = 0; k < 8; ++k) r.v[k] = __builtin_fma(a.v[k], b.v[k], c.v[k]);
   return r;
 }
-inline PF mul_add(PF a, PF b, PF c) { return unfused_mul_add(a, b, c); }
+using unfused_float::mul_add;
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
 }  // namespace fused_hw
@@ -253,7 +228,7 @@ namespace fused_soft {
 using fused_hw::mul_add;
 #else
 inline PD mul_add(PD a, PD b, PD c) { return PD{soft_fma::fma(a.v, b.v, c.v)}; }
-inline PF mul_add(PF a, PF b, PF c) { return unfused_mul_add(a, b, c); }
+using unfused_float::mul_add;
 #endif
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
@@ -275,7 +250,7 @@ inline PD mul_add(PD a, PD b, PD c) {
                                           (__m256d)__builtin_shufflevector(c.v, c.v, 4, 5, 6, 7));
   return PD{__builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7)};
 }
-inline PF mul_add(PF a, PF b, PF c) { return unfused_mul_add(a, b, c); }
+using unfused_float::mul_add;
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
 }  // namespace fused_avx2
@@ -403,7 +378,7 @@ template <>
 inline V16 cst<V16>(double x) { return _mm512_set1_ps(static_cast<float>(x)); }
 // mul_add, neg_mul_add, dot3 as for the portable lanes (fused: one rounding)
 inline V8 mul_add(V8 a, V8 b, V8 c) { return _mm512_fmadd_pd(a, b, c); }
-inline V16 mul_add(V16 a, V16 b, V16 c) { return add(mul(a, b), c); }  // unfused_mul_add
+inline V16 mul_add(V16 a, V16 b, V16 c) { return add(mul(a, b), c); }  // as unfused_float
 inline V8 neg_mul_add(V8 a, V8 b, V8 c) { return _mm512_fnmadd_pd(a, b, c); }
 inline V16 neg_mul_add(V16 a, V16 b, V16 c) { return sub(c, mul(a, b)); }
 inline V8 dot3(V8 a, V8 b, V8 c, V8 x, V8 y, V8 z) { return mul_add(c, z, mul_add(b, y, mul(a, x))); }
