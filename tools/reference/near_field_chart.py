@@ -31,6 +31,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import near_field_common as nfcommon  # noqa: E402
 import near_field_compare as nfc_compare  # noqa: E402
 import two_spheres as ts  # noqa: E402
 
@@ -221,11 +222,10 @@ def draw(out, lin, cells, gaps, fields, chains):
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", required=True)
-    p.add_argument("--magsolve", default="build/release/tools/magsolve")
+    nfcommon.add_magsolve(p)
     p.add_argument("--fem", default=os.path.join(HERE, "data", "near_field_fem.csv"))
     args = p.parse_args(argv)
-    if not os.access(args.magsolve, os.X_OK):
-        print(f"near_field_chart.py: {args.magsolve} is not an executable (build first)", file=sys.stderr)
+    if nfcommon.magsolve_missing(args.magsolve, "near_field_chart.py"):
         return 2
     os.makedirs(args.out, exist_ok=True)
     lin = linear_rows(args.magsolve)

@@ -21,6 +21,8 @@ import subprocess
 import sys
 import tempfile
 
+import near_field_common as nfcommon
+
 A, MS = 5e-3, 1.6e6
 V = 4.0 / 3.0 * math.pi * A ** 3
 MODELS = ("dipole", "pair")
@@ -74,11 +76,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     here = os.path.dirname(os.path.abspath(__file__))
     ap.add_argument("--fem", default=os.path.join(here, "data", "near_field_fem.csv"))
-    ap.add_argument("--magsolve", default="build/release/tools/magsolve")
+    nfcommon.add_magsolve(ap)
     ap.add_argument("--out", default=os.path.join(here, "data", "near_field_compare.csv"))
     args = ap.parse_args(argv)
-    if not os.access(args.magsolve, os.X_OK):
-        print(f"near_field_compare.py: {args.magsolve} is not an executable (build it first)", file=sys.stderr)
+    if nfcommon.magsolve_missing(args.magsolve, "near_field_compare.py"):
         return 2
     out = compare(args.fem, args.magsolve)
     with open(args.out, "w", newline="") as fh:
@@ -91,15 +92,10 @@ def main(argv=None):
     gaps = sorted({r["gap_over_a"] for r in out if r["N"] == 2}, reverse=True)
     for m in MODELS:
         print(f"\n{m} / FEM, two balls, force on the upper ball (rows g/a, columns H0/Ms):\n")
-        print("| g/a | " + " | ".join(f"{h:g}" for h in fields) + " |")
-        print("|---" * (len(fields) + 1) + "|")
-        for g in gaps:
-            cells = []
-            for h in fields:
-                r = next(r for r in out if r["N"] == 2 and r["gap_over_a"] == g and r["H0_over_Ms"] == h)
-                v = r[f"F_{m}_over_fem"]
-                cells.append(f"**{v:.2f}**" if not 0.85 <= v <= 1.15 else f"{v:.2f}")
-            print(f"| {g:g} | " + " | ".join(cells) + " |")
+        def cell(g, h, m=m):
+            r = next(r for r in out if r["N"] == 2 and r["gap_over_a"] == g and r["H0_over_Ms"] == h)
+            return nfcommon.pair_mark(r[f"F_{m}_over_fem"])
+        print("\n".join(nfcommon.gap_field_table(gaps, fields, cell)))
     for n in sorted({r["N"] for r in out if r["N"] > 2}):
         print(f"\nchain of {n} (g = 0.003a), model / FEM:\n")
         print("| H0/Ms | " + " | ".join(f"{q} {m}" for q in ("end ball", "middle ball", "moment") for m in MODELS) + " |")

@@ -42,6 +42,9 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import minimize, fsolve
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import near_field_common as nfcommon  # noqa: E402
+
 A, MS, MU0 = 5e-3, 1.6e6, 4e-7 * math.pi
 V = 4.0 / 3.0 * math.pi * A ** 3
 G_M, G_S = 1.5e-3, 5e-4  # contact gap and its softplus width (near_field.hpp)
@@ -210,6 +213,17 @@ def h_sat_of(gaps):
     return out
 
 
+def print_chain_ratios(rc, chains):
+    """One line per chain length: model / FEM of the end ball's force, the moment and (N > 3)
+    the middle ball's force, at every field."""
+    for n in sorted({c[0] for c in chains}):
+        sel = [c for c in chains if c[0] == n]
+        print(f"- chain of {n}, H0/Ms " + ", ".join(f"{c[2]:g}" for c in sel) + ": end ball "
+              + ", ".join(f"{rc[c]['end']:.2f}" for c in sel) + "; moment "
+              + ", ".join(f"{rc[c]['moment']:.2f}" for c in sel)
+              + ("; middle ball " + ", ".join(f"{rc[c]['mid']:.2f}" for c in sel) if n > 3 else ""))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--fem", default=os.path.join(HERE, "data", "near_field_fem.csv"))
@@ -273,27 +287,15 @@ def main(argv=None):
                        (f"candidate B (Dt at g_e + {kappa:.4g} h^{q:.3f})", cand_b)):
         print(f"\n{name}: pair model / FEM, two balls (T = training cell, C = check cell):\n")
         r = ratio_table(cells, corr, pairs)
-        print("| g/a | " + " | ".join(f"{h:g}" for h in fields) + " |")
-        print("|---" * (len(fields) + 1) + "|")
-        for g in gaps:
-            row = []
-            for h in fields:
-                v = r[(2, g, h)]["end"]
-                tag = "T" if (2, g, h) in train else "C"
-                row.append((f"**{v:.2f}**" if not 0.85 <= v <= 1.15 else f"{v:.2f}") + f" {tag}")
-            print(f"| {g:g} | " + " | ".join(row) + " |")
+        print("\n".join(nfcommon.gap_field_table(
+            gaps, fields, lambda g, h: nfcommon.pair_mark(r[(2, g, h)]["end"]) + (" T" if (2, g, h) in train else " C"))))
         for part in (train, check):
             vals = [r[c]["end"] for c in part]
             inside = sum(0.85 <= v <= 1.15 for v in vals)
             print(f"- {'training' if part is train else 'check'}: {inside}/{len(vals)} in 0.85-1.15, "
                   f"range {min(vals):.2f}-{max(vals):.2f}")
         rc = ratio_table(cells, corr, chains)
-        for n in sorted({c[0] for c in chains}):
-            sel = [c for c in chains if c[0] == n]
-            print(f"- chain of {n}, H0/Ms " + ", ".join(f"{c[2]:g}" for c in sel) + ": end ball "
-                  + ", ".join(f"{rc[c]['end']:.2f}" for c in sel) + "; moment "
-                  + ", ".join(f"{rc[c]['moment']:.2f}" for c in sel)
-                  + ("; middle ball " + ", ".join(f"{rc[c]['mid']:.2f}" for c in sel) if n > 3 else ""))
+        print_chain_ratios(rc, chains)
     # candidate C: B with the contact count, (beta, gamma) on a grid fitted to the 3-chains
     # (least squares of ln ratio of the end ball's force and the moment), checked on the 5-chains
     c3 = [c for c in chains if c[0] == 3]
@@ -308,12 +310,7 @@ def main(argv=None):
     print(f"\ncandidate C (B with nb^-{beta:g} and kappa nb^{gamma:g}; fitted on the 3-chains, "
           f"checked on the 5-chains; pairs are B's, nb = 1):")
     rc = ratio_table(cells, counted_correction(kappa, q, beta, gamma), chains)
-    for n in sorted({c[0] for c in chains}):
-        sel = [c for c in chains if c[0] == n]
-        print(f"- chain of {n}, H0/Ms " + ", ".join(f"{c[2]:g}" for c in sel) + ": end ball "
-              + ", ".join(f"{rc[c]['end']:.2f}" for c in sel) + "; moment "
-              + ", ".join(f"{rc[c]['moment']:.2f}" for c in sel)
-              + ("; middle ball " + ", ".join(f"{rc[c]['mid']:.2f}" for c in sel) if n > 3 else ""))
+    print_chain_ratios(rc, chains)
     return 0
 
 

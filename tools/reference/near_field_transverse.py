@@ -32,6 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import near_field_chart as nfc  # noqa: E402
+import near_field_common as nfcommon  # noqa: E402
 import two_spheres as ts  # noqa: E402
 
 A, MS, MU_R = 5e-3, 1.6e6, 1000.0
@@ -74,11 +75,10 @@ def interior_field_max(sol, n_theta=721, depth=1e-3, h=1e-6):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     here = os.path.dirname(os.path.abspath(__file__))
-    ap.add_argument("--magsolve", default="build/release/tools/magsolve")
+    nfcommon.add_magsolve(ap)
     ap.add_argument("--out", default=os.path.join(here, "data", "near_field_transverse.csv"))
     args = ap.parse_args(argv)
-    if not os.access(args.magsolve, os.X_OK):
-        print(f"near_field_transverse.py: {args.magsolve} is not an executable (build it first)", file=sys.stderr)
+    if nfcommon.magsolve_missing(args.magsolve, "near_field_transverse.py"):
         return 2
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import fsolve, minimize
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import near_field_common as nfcommon  # noqa: E402
 import near_field_fade as nf  # noqa: E402
 
 A, MS, MU0, V = nf.A, nf.MS, nf.MU0, nf.V
@@ -103,14 +104,8 @@ def ssq(r, what=("end",)):
 
 def print_pairs(name, r, gaps, fields, train):
     print(f"\n{name}: pair / FEM (T training, C check):\n")
-    print("| g/a | " + " | ".join(f"{h:g}" for h in fields) + " |")
-    print("|---" * (len(fields) + 1) + "|")
-    for g in gaps:
-        row = []
-        for h in fields:
-            v = r[(2, g, h)]["end"]
-            row.append((f"**{v:.2f}**" if not 0.85 <= v <= 1.15 else f"{v:.2f}") + (" T" if (2, g, h) in train else " C"))
-        print(f"| {g:g} | " + " | ".join(row) + " |")
+    print("\n".join(nfcommon.gap_field_table(gaps, fields, lambda g, h: nfcommon.pair_mark(r[(2, g, h)]["end"])
+                                               + (" T" if (2, g, h) in train else " C"))))
     for label, part in (("training", train), ("check", [k for k in r if k not in train])):
         vals = [r[k]["end"] for k in part]
         print(f"- {label}: {sum(0.85 <= v <= 1.15 for v in vals)}/{len(vals)} in 0.85-1.15, "

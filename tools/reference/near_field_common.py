@@ -1,0 +1,32 @@
+"""tools/reference/near_field_common.py — what the near-field reference scripts share: the
+magsolve argument and its check, and the markdown table of a ratio per gap × field cell."""
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+MAGSOLVE = "build/release/tools/magsolve"
+
+
+def add_magsolve(parser):
+    """--magsolve, the engine's solver binary (relative to the repository's root)."""
+    parser.add_argument("--magsolve", default=MAGSOLVE)
+
+
+def magsolve_missing(path, prog):
+    """True (and one line on stderr) when path is not an executable: build it first."""
+    if os.access(path, os.X_OK):
+        return False
+    print(f"{prog}: {path} is not an executable (build it first)", file=sys.stderr)
+    return True
+
+
+def pair_mark(v):
+    """v to two places, bold outside the pair model's axial mark 0.85-1.15."""
+    return f"**{v:.2f}**" if not 0.85 <= v <= 1.15 else f"{v:.2f}"
+
+
+def gap_field_table(gaps, fields, cell):
+    """Markdown lines: a row per gap g/a, a column per H0/Ms, cell(g, h) the text of a cell."""
+    lines = ["| g/a | " + " | ".join(f"{h:g}" for h in fields) + " |", "|---" * (len(fields) + 1) + "|"]
+    lines += [f"| {g:g} | " + " | ".join(cell(g, h) for h in fields) + " |" for g in gaps]
+    return lines
