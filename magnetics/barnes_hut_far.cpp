@@ -1,10 +1,11 @@
 // magnetics/barnes_hut_far.cpp — the far-cell series of Barnes–Hut (barnes_hut.cpp). One
-// body (far_block.inc) is compiled over portable lanes (for any CPU and for AVX2+FMA) and
-// over AVX-512 registers, each in double (CellBuffer, 8 cells per block) and in single
-// precision (CellBufferF, 16 cells per block, BarnesHutOptions::far_float); all give the same
-// bits (simd.hpp).
+// body (far_block.inc) is compiled over portable lanes (for any CPU), over AVX2+FMA
+// registers (simd_avx2.hpp) and over AVX-512 registers, each in double (CellBuffer, 8 cells
+// per block) and in single precision (CellBufferF, 16 cells per block,
+// BarnesHutOptions::far_float); all give the same bits (simd.hpp).
 #include "magnetics/barnes_hut_internal.hpp"
 #include "magnetics/simd.hpp"
+#include "magnetics/simd_avx2.hpp"
 
 #include <cmath>
 #include <type_traits>
@@ -73,13 +74,12 @@ using LaneOf = detail::simd::PortableLaneOf<T>;
 }  // namespace portable
 
 #ifdef MAGSIM_FMA_KERNEL
-// … over the same lanes where the CPU has AVX2 and FMA …
+// … over AVX2 registers where the CPU has AVX2 and FMA (two per lane set) …
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace fma {
-using namespace detail::simd::fused_avx2;  // FMA instructions on the register halves
 template <class T>
-using LaneOf = detail::simd::PortableLaneOf<T>;
+using LaneOf = detail::simd::Avx2LaneOf<T>;
 #include "magnetics/far_block.inc"
 }  // namespace fma
 #pragma GCC pop_options

@@ -1,13 +1,14 @@
 // magnetics/pair_kernel.cpp — the pair kernel of field_kernel.hpp (sum_pairs in double for
 // the direct sum and the Barnes–Hut near field, sum_pairs_f32 in float for the Barnes–Hut
 // near field). One body (pair_sweep.inc) is compiled three times: over portable lanes for
-// any CPU, over the same lanes for AVX2+FMA, and over AVX-512 registers. All run 8 double or
-// 16 float lanes with the same operations in the same order (simd.hpp), so they give the
-// same bits, and the choice between them (kernel_path) changes speed only. Float sums run over chunks of kChunkF sources
-// per lane set and are then added in double, so the float rounding of the sum does not grow
-// with the list; a double sweep is one chunk.
+// any CPU, over AVX2+FMA registers (simd_avx2.hpp) and over AVX-512 registers. All run 8
+// double or 16 float lanes with the same operations in the same order (simd.hpp), so they
+// give the same bits, and the choice between them (kernel_path) changes speed only. Float
+// sums run over chunks of kChunkF sources per lane set and are then added in double, so the
+// float rounding of the sum does not grow with the list; a double sweep is one chunk.
 #include "magnetics/field_kernel.hpp"
 #include "magnetics/simd.hpp"
+#include "magnetics/simd_avx2.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -71,13 +72,12 @@ using LaneOf = simd::PortableLaneOf<T>;
 }  // namespace portable
 
 #ifdef MAGSIM_FMA_KERNEL
-// … over the same lanes where the CPU has AVX2 and FMA …
+// … over AVX2 registers where the CPU has AVX2 and FMA (two per lane set) …
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 namespace fma {
-using namespace simd::fused_avx2;  // FMA instructions on the register halves
 template <class T>
-using LaneOf = simd::PortableLaneOf<T>;
+using LaneOf = simd::Avx2LaneOf<T>;
 #include "magnetics/pair_sweep.inc"
 }  // namespace fma
 #pragma GCC pop_options

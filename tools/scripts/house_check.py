@@ -54,11 +54,11 @@ RULES = [
 # builds on them.
 LAYERS = [
     (("magnetics/source_buffer.*", "magnetics/field_kernel.hpp", "magnetics/pair_kernel.cpp",
-      "magnetics/simd.hpp", "magnetics/dipole_field.*", "magnetics/barnes_hut*"),
+      "magnetics/simd*.hpp", "magnetics/dipole_field.*", "magnetics/barnes_hut*"),
      ("magnetics/fields.hpp",),
      "fields.hpp dispatches to the direct sum and to Barnes-Hut"),
     (("magnetics/source_buffer.*", "magnetics/field_kernel.hpp", "magnetics/pair_kernel.cpp",
-      "magnetics/simd.hpp"),
+      "magnetics/simd*.hpp"),
      ("magnetics/dipole_field.hpp",),
      "the pair kernel sits below the direct sum that calls it"),
     (("magnetics/anderson.*", "magnetics/magnetization_types.hpp"),
