@@ -22,8 +22,8 @@
 #define MAGSIM_AVX512_KERNEL 1
 #define MAGSIM_TARGET_AVX512 __attribute__((target("avx512f")))
 #endif
-// The portable lanes are also compiled for AVX2+FMA (per region, chosen at run time), in
-// every x86-64 build: there their fused multiply-adds are single instructions.
+// The AVX2+FMA kernels (simd_avx2.hpp) are compiled per region too, chosen at run time, in
+// every x86-64 build: for CPUs with FMA but no AVX-512.
 #if defined(__x86_64__) && defined(__GNUC__)
 #define MAGSIM_FMA_KERNEL 1
 #endif
@@ -62,7 +62,7 @@ enum class PairTerms { H, HJ };
 /// Adds to H[0..2] the field (eq. 1) at t of every source in v except t's own, and with
 /// PairTerms::HJ to J[0..5] (xx, yy, zz, xy, xz, yz) the Jacobian of those not in t's group.
 /// Softened with eps2 = ε². Results in A/m (A/m²). Dispatches to AVX-512 where the CPU has
-/// it, else portable lanes; both give the same bits (simd.hpp).
+/// it, else AVX2+FMA, else portable lanes; all give the same bits (simd.hpp).
 ///
 /// Bounded pairs (v.rad != nullptr): a pair closer than R = a_i + a_t is evaluated at the
 /// separation R along its own direction, r → r·R/|r| (field and Jacobian alike), so an
@@ -123,7 +123,7 @@ inline constexpr std::size_t kChunkF = 1024;
 /// far cells), fastest first. They give the same bits; the choice changes speed only.
 enum class KernelPath {
   Avx512,   ///< AVX-512 registers (native builds, CPUs with AVX-512F)
-  Fma,      ///< portable lanes compiled for AVX2+FMA (CPUs with both)
+  Fma,      ///< AVX2+FMA registers (simd_avx2.hpp; CPUs with both)
   Generic,  ///< portable lanes for any x86-64: fused multiply-adds emulated (simd.hpp soft_fma)
 };
 /// "avx512", "fma" or "generic"

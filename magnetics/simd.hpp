@@ -1,14 +1,15 @@
-// magnetics/simd.hpp — internal: the lane operations of the field kernels, in two sets that
+// magnetics/simd.hpp — internal: the lane operations of the field kernels, in three sets that
 // give the same bits: portable lanes (PD, PF: GCC generic vectors that the compiler splits into
-// the CPU's width) and AVX-512 registers (__m512d, __m512). A kernel body is written once over
-// these names (pair_sweep.inc, far_block.inc) and compiled for both sets (the portable lanes
-// twice: for any x86-64 and for AVX2+FMA), so its result does not depend on the CPU. Every
-// operation is element-wise IEEE and correctly rounded (+, −, ×, ÷, √, fused a·b + c, max,
-// compare, select), sums across lanes follow one tree (hsum), and 1/√q is 1 ÷ √q on both.
-// mul_add is always fused, never contracted by the compiler: one rounding on every CPU, in
-// the FMA instruction or, on a CPU without it, in soft_fma's exact emulation below. Double
-// kernels run 8 lanes, float kernels 16, whatever the hardware width. Include only from
-// magnetics/*.cpp, after field_kernel.hpp.
+// the CPU's width), AVX2+FMA registers (simd_avx2.hpp: pairs of __m256d, __m256) and AVX-512
+// registers (__m512d, __m512). A kernel body is written once over these names
+// (pair_sweep.inc, far_block.inc) and compiled for each set, so its result does not depend on
+// the CPU. Every operation is element-wise IEEE and correctly rounded (+, −, ×, ÷, √, fused
+// a·b + c, max, compare, select), sums across lanes follow one tree (hsum), and 1/√q is
+// 1 ÷ √q on all three. Double mul_add is always fused, never contracted by the compiler: one
+// rounding on every CPU, in the FMA instruction or, on a CPU without it, in soft_fma's exact
+// emulation below (float mul_add rounds twice everywhere: unfused_float). Double kernels run 8
+// lanes, float kernels 16, whatever the hardware width. Include only from magnetics/*.cpp,
+// after field_kernel.hpp.
 #pragma once
 
 #include "magnetics/field_kernel.hpp"
@@ -111,15 +112,14 @@ MAGSIM_PORTABLE_OPS(PF, MF, float, 16)
 
 // ---- fused a·b + c of the portable lanes -------------------------------------------------
 //
-// Three sets of mul_add, neg_mul_add and dot3 with the same bits; each instance of a kernel
-// body picks one with a using-directive before its #include (pair_kernel.cpp,
+// Two sets of mul_add, neg_mul_add and dot3 with the same bits; the portable instance of a
+// kernel body picks one with a using-directive before its #include (pair_kernel.cpp,
 // barnes_hut_far.cpp). The header cannot pick by itself: GCC 12 does not change __FMA__
 // inside a `#pragma GCC target` region, and these functions are defined outside any.
-//   fused_avx2: the AVX2+FMA instance's: FMA intrinsics on the register halves (inside a
-//               target region, so only that instance can inline them);
 //   fused_hw:   __builtin_fma per lane (a call to glibc's fma where the build has no FMA);
 //   fused_soft: for the instance of a CPU without FMA: soft_fma below, in +, −, × and bit
 //               operations that SSE2 vectorizes (fused_hw where the whole build has FMA).
+// The AVX2+FMA instance has its own registers and FMA instructions (simd_avx2.hpp).
 
 /// Correctly rounded (round-to-nearest-even) a·b + c lane by lane, bit for bit the FMA
 /// instruction's result, from element-wise +, −, ×: no FMA instruction needed.
@@ -233,29 +233,6 @@ using unfused_float::mul_add;
 MAGSIM_FUSED_OPS(PD)
 MAGSIM_FUSED_OPS(PF)
 }  // namespace fused_soft
-
-#ifdef MAGSIM_FMA_KERNEL
-// fused_avx2: the AVX2+FMA instance's set, two FMA instructions per lane set. Written with
-// intrinsics on the register halves: GCC 12 leaves fused_hw's per-lane loop scalar there.
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
-namespace fused_avx2 {
-typedef double VecD4 __attribute__((vector_size(32)));
-inline PD mul_add(PD a, PD b, PD c) {
-  const VecD4 lo = (VecD4)_mm256_fmadd_pd((__m256d)__builtin_shufflevector(a.v, a.v, 0, 1, 2, 3),
-                                          (__m256d)__builtin_shufflevector(b.v, b.v, 0, 1, 2, 3),
-                                          (__m256d)__builtin_shufflevector(c.v, c.v, 0, 1, 2, 3));
-  const VecD4 hi = (VecD4)_mm256_fmadd_pd((__m256d)__builtin_shufflevector(a.v, a.v, 4, 5, 6, 7),
-                                          (__m256d)__builtin_shufflevector(b.v, b.v, 4, 5, 6, 7),
-                                          (__m256d)__builtin_shufflevector(c.v, c.v, 4, 5, 6, 7));
-  return PD{__builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7)};
-}
-using unfused_float::mul_add;
-MAGSIM_FUSED_OPS(PD)
-MAGSIM_FUSED_OPS(PF)
-}  // namespace fused_avx2
-#pragma GCC pop_options
-#endif
 
 #undef MAGSIM_FUSED_OPS
 
