@@ -177,8 +177,8 @@ void check_lane_set(int rounds) {
 
 }  // namespace
 
-TEST_CASE("simd_avx2: every AVX2 lane operation gives the contract's bits, masked lanes "
-          "included (double and float; ±0, inf, NaN, subnormals)",
+TEST_CASE("simd_avx2: every AVX2 lane operation gives the contract's bits in double and float "
+          "lanes, masked lanes included (signed zeros, inf, NaN, subnormals)",
           "[simd][kernel]") {
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) {
     WARN("no AVX2+FMA on this CPU: the AVX2 lane set is not run");
