@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 #ifdef MAGSIM_FMA_KERNEL
 #include <immintrin.h>
 #endif
@@ -236,17 +237,15 @@ MAGSIM_FUSED_OPS(PF)
 
 #undef MAGSIM_FUSED_OPS
 
-/// The portable lane set of a scalar type (a kernel body reads LaneOf<T>::V)
+/// A lane set's type for the scalar T (double → D, float → F); each instance of a kernel body
+/// names its set as LaneOf and reads LaneOf<T>::V
+template <class T, class D, class F>
+struct LaneSetOf {
+  using V = std::conditional_t<std::is_same_v<T, double>, D, F>;
+};
+/// The portable lane set
 template <class T>
-struct PortableLaneOf;
-template <>
-struct PortableLaneOf<double> {
-  using V = PD;
-};
-template <>
-struct PortableLaneOf<float> {
-  using V = PF;
-};
+using PortableLaneOf = LaneSetOf<T, PD, PF>;
 
 /// A constant in every lane of V (cst<PD>(x), cst<V8>(x), …)
 template <class V>
@@ -331,7 +330,8 @@ inline V8 mul_in(__mmask8 k, V8 a, V8 b) { return _mm512_mask_mul_pd(a, k, a, b)
 inline V16 mul_in(__mmask16 k, V16 a, V16 b) { return _mm512_mask_mul_ps(a, k, a, b); }
 inline V8 splat(V8, double x) { return _mm512_set1_pd(x); }
 inline V16 splat(V16, double x) { return _mm512_set1_ps(static_cast<float>(x)); }
-/// The AVX-512 lane set of a scalar type
+/// The AVX-512 lane set (specialized by hand: a vector type with attributes as a template
+/// argument, as LaneSetOf would take it, draws -Wignored-attributes)
 template <class T>
 struct Avx512LaneOf;
 template <>

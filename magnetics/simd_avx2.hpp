@@ -37,17 +37,9 @@ struct A16m {
   __m256 lo, hi;
 };
 
-/// The AVX2 lane set of a scalar type (a kernel body reads LaneOf<T>::V)
+/// The AVX2 lane set
 template <class T>
-struct Avx2LaneOf;
-template <>
-struct Avx2LaneOf<double> {
-  using V = A8;
-};
-template <>
-struct Avx2LaneOf<float> {
-  using V = A16;
-};
+using Avx2LaneOf = LaneSetOf<T, A8, A16>;
 
 // clang-format off
 inline A8 ld(const double* p, A8) { return A8{_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)}; }
