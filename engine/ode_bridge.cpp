@@ -120,7 +120,7 @@ struct OdeBridge::Impl {
   dSurfaceParameters rolling{};  ///< surface of contacts with a non-dynamic body
   dSurfaceParameters between{};  ///< surface of contacts between two dynamic bodies
   int max_contacts = 4;
-  bool skip_resting = false;  ///< this collide skips pairs of two resting bodies (some body sleeps)
+  bool skip_resting = false;  ///< some body is disabled (asleep) in this collide: its sleep rules apply
   double damped_h = 0.0;  ///< the step length the damping factors are set for (s)
   double margin = 0.0;  ///< base speculative contact margin μ0 (m)
   std::vector<double> shape_margin;  ///< (nshape + 1) margin μ_s each geom is grown by now
@@ -405,7 +405,7 @@ struct OdeBridge::Impl {
       // a gap to a sleeping body (SimOptions::sleep) that the bodies do not close within the
       // step is held against it as against the world: the awake body cannot pass it, and
       // ODE does not enable the sleeper for it; one that closes ties them (the sleeper wakes)
-      if (d < 0 && model.options.sleep && b1 && b2 && (!dBodyIsEnabled(b1) || !dBodyIsEnabled(b2))) {
+      if (d < 0 && skip_resting && b1 && b2 && (!dBodyIsEnabled(b1) || !dBodyIsEnabled(b2))) {
         const dReal* v1 = dBodyGetLinearVel(b1);
         const dReal* v2 = dBodyGetLinearVel(b2);
         const double closing = std::abs((v1[0] - v2[0]) * r.g.normal[0] + (v1[1] - v2[1]) * r.g.normal[1] +
@@ -416,7 +416,7 @@ struct OdeBridge::Impl {
         }
       }
       dJointAttach(j, b1, b2);
-      if (joined && b1 && b2)
+      if (joined && skip_resting && b1 && b2)
         joined->emplace_back(std::min(tag[r.a].body, tag[r.b].body), std::max(tag[r.a].body, tag[r.b].body));
       if (d > -touch) {
         const int ba = tag[r.a].body, bb = tag[r.b].body;

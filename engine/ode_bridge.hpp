@@ -61,8 +61,9 @@ class OdeBridge {
   /// of h_soft (the same spring and damper at h; h_soft ≤ 0: at h), so that retaking a step
   /// in finer sub-steps does not push overlaps out faster. *max_depth (when given) gets the
   /// deepest overlap of any contact (m, ≥ 0; speculative gaps count as 0). *joined (when
-  /// given) gets every body pair a contact joint ties, sorted: ODE enables a disabled body
-  /// that a joint ties to an enabled one. With SimOptions::sleep a speculative contact to a
+  /// given) gets every body pair a contact joint ties, sorted, while some body is disabled
+  /// (empty otherwise: no sleeper to wake): ODE enables a disabled body that a joint ties to
+  /// an enabled one. With SimOptions::sleep a speculative contact to a
   /// disabled body whose gap the bodies' speed does not close within h ties the other body
   /// to the world instead.
   int collide(std::vector<std::pair<int, int>>* pairs, double h, double h_soft = 0.0,

@@ -144,9 +144,7 @@ void Simulation::attempt(int nsub, int nsub_soft, long n) {
         ScopedTimer c(&prof.collide_ms);
         ode_->update_margins(now, ws_.body_force, h);
         double depth = 0.0;
-        // the pairs that joints tie matter only while an island sleeps (a sort of every contact)
-        std::vector<std::pair<int, int>>* joined =
-            m.options.sleep && asleep_count(next) > 0 ? &ws_.joined : nullptr;
+        std::vector<std::pair<int, int>>* joined = m.options.sleep ? &ws_.joined : nullptr;
         prof.contacts = ode_->collide(&next.contact_pairs, h, m.options.dt / nsub_soft, &depth, joined);
         next.contact_depth = std::max(next.contact_depth, depth);
         // a sleeping island that a moving body's contact joint ties (ODE would enable the

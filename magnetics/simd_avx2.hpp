@@ -88,11 +88,6 @@ inline A16 splat(A16, double x) {
 }
 // clang-format on
 
-template <>
-inline A8 cst<A8>(double x) { return splat(A8(), x); }
-template <>
-inline A16 cst<A16>(double x) { return splat(A16(), x); }
-
 /// Lanes k < n
 inline A8m first_lanes(A8, std::size_t n) {
   const __m256i c = _mm256_set1_epi64x(static_cast<long long>(n < 8 ? n : 8));
