@@ -24,6 +24,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <sys/resource.h>
+
 namespace eng = magsim::engine;
 namespace mag = magsim::mag;
 using nlohmann::json;
@@ -119,12 +121,20 @@ Window measure(const std::string& scene, mag::Method method, int count, int warm
   return w;
 }
 
+// The process's peak resident memory so far (MB; getrusage's ru_maxrss is in kB on Linux).
+double peak_resident_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
 // A whole run, as a user pays for it: the scene's standard run (or `seconds`), wall time per
-// simulated second, the means per step of its first and last 0.5 s, and the warm window's
-// medians (steps [warmup, warmup + steps)) from the same run.
+// simulated second, the means per step of its first and last 0.5 s and of its last second, and
+// the warm window's medians (steps [warmup, warmup + steps)) from the same run.
 struct WholeRun {
   double seconds = 0, wall = 0;
   double first[4] = {0, 0, 0, 0}, last[4] = {0, 0, 0, 0};  ///< T_i, T_f, T_r, step (ms)
+  double last_second[4] = {0, 0, 0, 0};                    ///< the same over the last 1 s
   Window window;
   int asleep = 0;  ///< bodies asleep at the end
   bool failed = false;
@@ -178,6 +188,7 @@ WholeRun whole_run(const std::string& scene, mag::Method method, int count, doub
   for (int q = 0; q < 4; ++q) {
     r.first[q] = mean(*parts[q], 0, std::min(m, half));
     r.last[q] = mean(*parts[q], std::max(0L, m - half), m);
+    r.last_second[q] = mean(*parts[q], std::max(0L, m - 2 * half), m);
   }
   if (m >= warmup + steps) {
     std::vector<double> a(ti.begin() + warmup, ti.begin() + warmup + steps), b(tf.begin() + warmup, tf.begin() + warmup + steps),
@@ -304,8 +315,8 @@ int main(int argc, char** argv) {
   doc["runs"] = json::array();
   if (whole) {
     doc["whole_run"] = json::array();
-    std::printf("%-15s %-15s %10s %10s %28s %28s %22s %7s\n", "scene", "method", "sim s", "wall/sim s",
-                "first 0.5 s T_i/T_f/T_r", "last 0.5 s T_i/T_f/T_r", "window T_i/T_f/T_r", "asleep");
+    std::printf("%-15s %-15s %10s %10s %28s %28s %12s %22s %7s\n", "scene", "method", "sim s", "wall/sim s",
+                "first 0.5 s T_i/T_f/T_r", "last 0.5 s T_i/T_f/T_r", "last 1 s step", "window T_i/T_f/T_r", "asleep");
     for (const std::string& s : split(scenes))
       for (const auto& [name, m] : ms) {
         const WholeRun r = whole_run(s, m, whole_count, whole_seconds, warmup, steps, threads, field);
@@ -313,6 +324,8 @@ int main(int argc, char** argv) {
                   {"wall_seconds", r.wall}, {"wall_per_simulated_second", r.seconds > 0 ? r.wall / r.seconds : 0.0},
                   {"first_half_second_ms", {{"T_i", r.first[0]}, {"T_f", r.first[1]}, {"T_r", r.first[2]}, {"step", r.first[3]}}},
                   {"last_half_second_ms", {{"T_i", r.last[0]}, {"T_f", r.last[1]}, {"T_r", r.last[2]}, {"step", r.last[3]}}},
+                  {"last_second_ms", {{"T_i", r.last_second[0]}, {"T_f", r.last_second[1]}, {"T_r", r.last_second[2]}, {"step", r.last_second[3]}}},
+                  {"peak_resident_mb", peak_resident_mb()},
                   {"window_median_ms", {{"T_i", r.window.T_i}, {"T_f", r.window.T_f}, {"T_r", r.window.T_r}, {"total", r.window.total}}},
                   {"asleep_at_end", r.asleep}};
         for (const PaperRow& pr : kPaper)
@@ -322,9 +335,9 @@ int main(int argc, char** argv) {
           }
         if (r.failed) j["error"] = r.error;
         doc["whole_run"].push_back(j);
-        std::printf("%-15s %-15s %10.3f %10.2f %10.2f/%7.2f/%8.2f %10.2f/%7.2f/%8.2f %7.2f/%6.2f/%7.2f %7d%s%s\n",
+        std::printf("%-15s %-15s %10.3f %10.2f %10.2f/%7.2f/%8.2f %10.2f/%7.2f/%8.2f %12.2f %7.2f/%6.2f/%7.2f %7d%s%s\n",
                     s.c_str(), name.c_str(), r.seconds, r.seconds > 0 ? r.wall / r.seconds : 0.0, r.first[0], r.first[1],
-                    r.first[2], r.last[0], r.last[1], r.last[2], r.window.T_i, r.window.T_f, r.window.T_r, r.asleep,
+                    r.first[2], r.last[0], r.last[1], r.last[2], r.last_second[3], r.window.T_i, r.window.T_f, r.window.T_r, r.asleep,
                     r.failed ? "  FAILED: " : "", r.failed ? r.error.c_str() : "");
         std::fflush(stdout);
       }
