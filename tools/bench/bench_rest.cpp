@@ -5,9 +5,10 @@
 // --steps from it under the scene's own options and under each --variant
 // (options-table keys set to values), so that every variant starts from the
 // same bits. Per variant: the means per step of T_i, T_f, T_r and T_r's collide
-// and QuickStep parts, rigid sub-steps, contact joints, bodies asleep at the
-// end, the fastest body at the end and the deepest contact over the window: the
-// cost beside what a viewer would see change.
+// and QuickStep parts, rigid sub-steps, contact joints, the magnetization's
+// sweeps (over all sub-steps), bodies asleep at the end, the fastest body at the
+// end and the deepest contact over the window: the cost beside what a viewer
+// would see change.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -140,23 +141,23 @@ int main(int argc, char** argv) {
     }
     saved = sim.save_state();
   }
-  std::printf("%-40s %7s %7s %7s %8s %9s %8s %9s %7s %10s %10s\n", "variant", "T_i", "T_f", "T_r", "collide",
-              "QuickStep", "substeps", "contacts", "asleep", "fastest", "deepest");
+  std::printf("%-40s %7s %7s %7s %8s %9s %8s %9s %7s %7s %10s %10s\n", "variant", "T_i", "T_f", "T_r", "collide",
+              "QuickStep", "substeps", "contacts", "sweeps", "asleep", "fastest", "deepest");
   for (const Variant& v : vs) {
     eng::SceneDesc d = base;
     apply(v, &d.options);
     eng::Simulation sim(d);
     sim.restore_state(saved);
-    double sum[7] = {0, 0, 0, 0, 0, 0, 0}, deepest = 0;
+    double sum[8] = {0, 0, 0, 0, 0, 0, 0, 0}, deepest = 0;
     std::string error;  // a blow-up under a variant ends its window, not the others
     int taken = 0;
     try {
       for (int k = 0; k < steps; ++k, ++taken) {
         sim.step();
         const eng::StepProfile& p = sim.last_profile();
-        const double parts[7] = {
-            p.T_i, p.T_f, p.T_r, p.collide_ms, p.quickstep_ms, double(p.substeps), double(p.contacts)};
-        for (int q = 0; q < 7; ++q) sum[q] += parts[q];
+        const double parts[8] = {p.T_i,          p.T_f,           p.T_r,           p.collide_ms,
+                                 p.quickstep_ms, double(p.substeps), double(p.contacts), double(p.iterations)};
+        for (int q = 0; q < 8; ++q) sum[q] += parts[q];
         deepest = std::max(deepest, sim.state().contact_depth);
       }
     } catch (const std::exception& e) {
@@ -167,9 +168,9 @@ int main(int argc, char** argv) {
     for (double& s : sum) s /= std::max(taken, 1);
     const int asleep = sim.last_profile().asleep;
     std::printf(
-        "%-40s %7.2f %7.2f %7.2f %8.2f %9.2f %8.2f %9.0f %7d %10.4f "
+        "%-40s %7.2f %7.2f %7.2f %8.2f %9.2f %8.2f %9.0f %7.2f %7d %10.4f "
         "%10.2e%s%s\n",
-        v.name.c_str(), sum[0], sum[1], sum[2], sum[3], sum[4], sum[5], sum[6], asleep, fastest, deepest,
+        v.name.c_str(), sum[0], sum[1], sum[2], sum[3], sum[4], sum[5], sum[6], sum[7], asleep, fastest, deepest,
         error.empty() ? "" : "  FAILED: ", error.c_str());
     std::fflush(stdout);
     doc["windows"].push_back(
@@ -177,6 +178,7 @@ int main(int argc, char** argv) {
          {"mean_ms", {{"T_i", sum[0]}, {"T_f", sum[1]}, {"T_r", sum[2]}, {"collide", sum[3]}, {"quickstep", sum[4]}}},
          {"substeps_mean", sum[5]},
          {"contacts_mean", sum[6]},
+         {"magnetization_sweeps_mean", sum[7]},
          {"asleep_at_end", asleep},
          {"fastest_at_end", fastest},
          {"deepest_contact", deepest},
