@@ -1,10 +1,10 @@
 // tools/bench/bench_rest.cpp — where a scene's step goes once it has come to
 // rest, and what each option would save there.
 //
-// Runs a registry scene once to --at seconds, keeps that state, then steps
-// --steps from it under the scene's own options and under each --variant
-// (options-table keys set to values), so that every variant starts from the
-// same bits. Per variant: the means per step of T_i, T_f, T_r and T_r's collide
+// Runs a registry scene (with --strength and the --set options) once to --at
+// seconds, keeps that state, then steps --steps from it under the scene's own
+// options and under each --variant (options-table keys set to values), so that
+// every variant starts from the same bits. Per variant: the means per step of T_i, T_f, T_r and T_r's collide
 // and QuickStep parts, rigid sub-steps, contact joints, the magnetization's
 // sweeps (over all sub-steps), bodies asleep at the end, the fastest body at the
 // end and the deepest contact over the window: the cost beside what a viewer
@@ -37,7 +37,7 @@ struct Variant {
 
 // "key=value,key=value" → sets; a key not in the options table or a bad value
 // is a one-line error (std::invalid_argument) before any step is taken.
-Variant parse_variant(const std::string& text) {
+Variant parse_variant(const std::string& text, const char* flag = "--variant") {
   Variant v{text, {}};
   std::size_t start = 0;
   while (start <= text.size()) {
@@ -45,7 +45,7 @@ Variant parse_variant(const std::string& text) {
     const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     const std::size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      throw std::invalid_argument("--variant '" + text + "': expected key=value[,key=value...]");
+      throw std::invalid_argument(std::string(flag) + " '" + text + "': expected key=value[,key=value...]");
     v.sets.emplace_back(item.substr(0, eq), item.substr(eq + 1));
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -97,7 +97,15 @@ int main(int argc, char** argv) {
   double at = 2.5;
   int steps = 200, threads = 2;
   std::vector<std::string> variants;
+  std::string set;
+  double strength = 1.0;
   app.add_option("--scene", scene, "a registry scene")->capture_default_str();
+  app.add_option("--strength", strength, "multiplies every permanent moment of the scene")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--set", set,
+                 "options-table keys and values for the run to --at and every window, e.g. "
+                 "sleep=false,quickstep_iterations=40");
   app.add_option("--at", at, "simulated seconds run once before the windows (s)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
@@ -116,9 +124,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::vector<Variant> vs = {{"scene", {}}};
-  eng::SceneDesc base = entry->build({});
+  magsim::scenes::SceneParams params;
+  params.strength = strength;
+  eng::SceneDesc base = entry->build(params);
   base.options.threads = threads;
   try {
+    if (!set.empty()) apply(parse_variant(set, "--set"), &base.options);
     for (const std::string& t : variants) {
       vs.push_back(parse_variant(t));
       eng::SimOptions check = base.options;
@@ -129,7 +140,8 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  json doc = {{"scene", scene}, {"at_seconds", at}, {"steps", steps}, {"threads", threads}, {"windows", json::array()}};
+  json doc = {{"scene", scene},     {"strength", strength},    {"set", set}, {"at_seconds", at}, {"steps", steps},
+              {"threads", threads}, {"windows", json::array()}};
   eng::State saved;
   {
     eng::Simulation sim(base);
@@ -155,8 +167,14 @@ int main(int argc, char** argv) {
       for (int k = 0; k < steps; ++k, ++taken) {
         sim.step();
         const eng::StepProfile& p = sim.last_profile();
-        const double parts[8] = {p.T_i,          p.T_f,           p.T_r,           p.collide_ms,
-                                 p.quickstep_ms, double(p.substeps), double(p.contacts), double(p.iterations)};
+        const double parts[8] = {p.T_i,
+                                 p.T_f,
+                                 p.T_r,
+                                 p.collide_ms,
+                                 p.quickstep_ms,
+                                 double(p.substeps),
+                                 double(p.contacts),
+                                 double(p.iterations)};
         for (int q = 0; q < 8; ++q) sum[q] += parts[q];
         deepest = std::max(deepest, sim.state().contact_depth);
       }
