@@ -77,10 +77,10 @@ void apply(const Variant& v, eng::SimOptions* o) {
   for (const auto& [key, text] : v.sets) {
     const auto& table = eng::options_table();
     const auto it = std::find_if(table.begin(), table.end(), [&](const eng::OptionSpec& s) { return s.key == key; });
-    if (it == table.end()) throw std::invalid_argument("--variant: unknown option '" + key + "'");
+    if (it == table.end()) throw std::invalid_argument("unknown option '" + key + "'");
     const eng::OptionValue x = value_of(*it, text);
     const std::string err = it->error(x);
-    if (!err.empty()) throw std::invalid_argument("--variant: " + key + " " + err);
+    if (!err.empty()) throw std::invalid_argument(key + " " + err);
     it->set(*o, x);
   }
 }
