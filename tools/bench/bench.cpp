@@ -9,6 +9,7 @@
 // `dipole` and `pair`, and writes the ratio pair/dipole of T_i + T_f + T_r per step.
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
+#include "tools/bench/bench_common.hpp"
 #include "tools/cli/option_flags.hpp"
 
 #include <CLI/CLI.hpp>
@@ -21,7 +22,6 @@
 #include <fstream>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
 #include <sys/resource.h>
@@ -44,21 +44,8 @@ const PaperRow kPaper[] = {
     {"sakura_tree", {778, 97, 65}, {61, 101, 75}},
 };
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string x;
-  while (std::getline(ss, x, ','))
-    if (!x.empty()) out.push_back(x);
-  return out;
-}
+using magsim::bench::median;
+using magsim::bench::split;
 
 struct Window {
   double T_i = 0, T_f = 0, T_r = 0, total = 0, iters = 0, cap_frac = 0;

@@ -4,10 +4,10 @@
 //
 // Plain ODE, no magnetics: piles of 5 mm balls dropped onto the ground plane, `--piles`
 // islands of `--balls` each; contacts in a sorted order, up to 4 per pair, as magsim's bridge
-// makes them (here μ = 0.5, ERP 0.2, CFM 1e-9, and ODE's RNG seeded per step). Each thread count runs the same scene from the
-// same start; per run: ms per step (collide + QuickStep) over the last `--window` steps (median)
-// and an FNV-1a hash of the final positions and velocities, compared with the one-thread run
-// and with a second run at the same thread count.
+// makes them (here μ = 0.5, ERP 0.2, CFM 1e-9, and ODE's RNG seeded per step). Each thread
+// count runs the same scene from the same start; per run: ms per step (collide + QuickStep) over the last `--window`
+// steps (median) and an FNV-1a hash of the final positions and velocities, compared with the one-thread run and with a
+// second run at the same thread count.
 #include <ode/ode.h>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +24,8 @@
 #include <tuple>
 #include <vector>
 
+#include "tools/bench/bench_common.hpp"
+
 namespace {
 
 struct Run {
@@ -36,8 +38,7 @@ struct World {
   dWorldID world = nullptr;
   dSpaceID space = nullptr;
   dJointGroupID group = nullptr;
-  std::vector<dBodyID> bodies;
-  std::vector<dGeomID> geoms;
+  std::vector<dBodyID> bodies;  ///< their geoms go with the space
   int contacts = 0;
 };
 
@@ -109,7 +110,6 @@ World make_world(int piles, int balls) {
       dGeomID g = dCreateSphere(w.space, r);
       dGeomSetBody(g, b);
       w.bodies.push_back(b);
-      w.geoms.push_back(g);
     }
   }
   return w;
@@ -149,8 +149,7 @@ Run run(int piles, int balls, int threads, int steps, int window, int iterations
     if (k >= steps - window) ms.push_back(dt);
   }
   Run r;
-  std::sort(ms.begin(), ms.end());
-  r.median_ms = ms.empty() ? 0 : ms[ms.size() / 2];
+  r.median_ms = magsim::bench::median(ms);
   r.hash = hash_state(w);
   r.contacts = w.contacts;
   if (impl) {
@@ -192,15 +191,13 @@ int main(int argc, char** argv) {
   }
   std::vector<int> piles;
   try {
-    std::size_t start = 0;
-    while (start <= piles_text.size()) {
-      const std::size_t c = piles_text.find(',', start);
-      const int p = std::stoi(piles_text.substr(start, c == std::string::npos ? std::string::npos : c - start));
-      if (p < 1 || p > 64) throw std::out_of_range("");
+    for (const std::string& item : magsim::bench::split(piles_text)) {
+      std::size_t used = 0;
+      const int p = std::stoi(item, &used);
+      if (used != item.size() || p < 1 || p > 64) throw std::out_of_range(item);
       piles.push_back(p);
-      if (c == std::string::npos) break;
-      start = c + 1;
     }
+    if (piles.empty()) throw std::out_of_range(piles_text);
   } catch (const std::exception&) {
     std::fprintf(stderr, "bench_ode_threads: --piles '%s': expected a comma list of integers in [1, 64]\n",
                  piles_text.c_str());

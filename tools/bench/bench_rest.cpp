@@ -1,14 +1,13 @@
-// tools/bench/bench_rest.cpp — where a scene's step goes once it has come to
-// rest, and what each option would save there.
+// tools/bench/bench_rest.cpp — where a scene's step goes once it has come to rest, and what
+// each option would save there.
 //
-// Runs a registry scene (with --strength and the --set options) once to --at
-// seconds, keeps that state, then steps --steps from it under the scene's own
-// options and under each --variant (options-table keys set to values), so that
-// every variant starts from the same bits. Per variant: the means per step of T_i, T_f, T_r and T_r's collide
-// and QuickStep parts, rigid sub-steps, contact joints, the magnetization's
-// sweeps (over all sub-steps), bodies asleep at the end, the fastest body at the
-// end and the deepest contact over the window: the cost beside what a viewer
-// would see change.
+// Runs a registry scene (with --strength and the --set options) once to --at seconds, keeps
+// that state, then steps --steps from it under the scene's own options and under each
+// --variant (options-table keys set to values), so that every variant starts from the same
+// bits. Per variant: the means per step of T_i, T_f, T_r and T_r's collide and QuickStep
+// parts, rigid sub-steps, contact joints, the magnetization's sweeps (over all sub-steps),
+// bodies asleep at the end, the fastest body at the end and the deepest contact over the
+// window: the cost beside what a viewer would see change.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -16,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -24,6 +24,7 @@
 #include "engine/options_table.hpp"
 #include "engine/simulation.hpp"
 #include "scenes/registry.hpp"
+#include "tools/bench/bench_common.hpp"
 
 namespace eng = magsim::engine;
 using json = nlohmann::json;
@@ -35,21 +36,19 @@ struct Variant {
   std::vector<std::pair<std::string, std::string>> sets;  ///< key, value as typed
 };
 
-// "key=value,key=value" → sets; a key not in the options table or a bad value
-// is a one-line error (std::invalid_argument) before any step is taken.
+// "key=value,key=value" → sets; an item without a key or a value (or an empty
+// one) is a one-line error (std::invalid_argument) before any step is taken.
 Variant parse_variant(const std::string& text, const char* flag = "--variant") {
   Variant v{text, {}};
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+  const std::vector<std::string> items = magsim::bench::split(text);
+  const auto commas = static_cast<std::size_t>(std::count(text.begin(), text.end(), ','));
+  for (const std::string& item : items) {
     const std::size_t eq = item.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-      throw std::invalid_argument(std::string(flag) + " '" + text + "': expected key=value[,key=value...]");
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) break;
     v.sets.emplace_back(item.substr(0, eq), item.substr(eq + 1));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
   }
+  if (v.sets.size() != commas + 1)
+    throw std::invalid_argument(std::string(flag) + " '" + text + "': expected key=value[,key=value...]");
   return v;
 }
 
@@ -143,7 +142,7 @@ int main(int argc, char** argv) {
   json doc = {{"scene", scene},     {"strength", strength},    {"set", set}, {"at_seconds", at}, {"steps", steps},
               {"threads", threads}, {"windows", json::array()}};
   eng::State saved;
-  {
+  try {  // a scene the options refuse, or a blow-up before --at: one line, exit 2
     eng::Simulation sim(base);
     const long n0 = std::lround(at / base.options.dt);
     for (long k = 0; k < n0; ++k) {
@@ -152,21 +151,25 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench_rest: %s to %.3f s, step %ld/%ld\n", scene.c_str(), at, k + 1, n0);
     }
     saved = sim.save_state();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_rest: %s before %g s: %s\n", scene.c_str(), at, e.what());
+    return 2;
   }
   std::printf("%-40s %7s %7s %7s %8s %9s %8s %9s %7s %7s %10s %10s\n", "variant", "T_i", "T_f", "T_r", "collide",
               "QuickStep", "substeps", "contacts", "sweeps", "asleep", "fastest", "deepest");
   for (const Variant& v : vs) {
     eng::SceneDesc d = base;
     apply(v, &d.options);
-    eng::Simulation sim(d);
-    sim.restore_state(saved);
-    double sum[8] = {0, 0, 0, 0, 0, 0, 0, 0}, deepest = 0;
-    std::string error;  // a blow-up under a variant ends its window, not the others
-    int taken = 0;
+    double sum[8] = {0, 0, 0, 0, 0, 0, 0, 0}, deepest = 0, fastest = 0;
+    std::string error;  // a variant refused or blowing up ends its window, not the others
+    int taken = 0, asleep = 0;
+    std::unique_ptr<eng::Simulation> sim;  // after a blow-up it holds the last good state
     try {
+      sim = std::make_unique<eng::Simulation>(d);
+      sim->restore_state(saved);
       for (int k = 0; k < steps; ++k, ++taken) {
-        sim.step();
-        const eng::StepProfile& p = sim.last_profile();
+        sim->step();
+        const eng::StepProfile& p = sim->last_profile();
         const double parts[8] = {p.T_i,
                                  p.T_f,
                                  p.T_r,
@@ -176,15 +179,16 @@ int main(int argc, char** argv) {
                                  double(p.contacts),
                                  double(p.iterations)};
         for (int q = 0; q < 8; ++q) sum[q] += parts[q];
-        deepest = std::max(deepest, sim.state().contact_depth);
+        deepest = std::max(deepest, sim->state().contact_depth);
       }
     } catch (const std::exception& e) {
       error = e.what();
     }
-    double fastest = 0;
-    for (const eng::Vec3& vel : sim.state().vel) fastest = std::max(fastest, vel.norm());
+    if (sim) {
+      for (const eng::Vec3& vel : sim->state().vel) fastest = std::max(fastest, vel.norm());
+      asleep = sim->last_profile().asleep;
+    }
     for (double& s : sum) s /= std::max(taken, 1);
-    const int asleep = sim.last_profile().asleep;
     std::printf(
         "%-40s %7.2f %7.2f %7.2f %8.2f %9.2f %8.2f %9.0f %7.2f %7d %10.4f "
         "%10.2e%s%s\n",
