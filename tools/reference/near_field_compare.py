@@ -5,12 +5,16 @@ force and moment ratios model / FEM for every pair cell and every chain.
 
     /usr/bin/python3 tools/reference/near_field_compare.py [--fem tools/reference/data/near_field_fem.csv]
         [--magsolve build/release/tools/magsolve] [--out tools/reference/data/near_field_compare.csv]
+    # the held-out chains (near_field_fem_table.py --extra-chains):
+    /usr/bin/python3 tools/reference/near_field_compare.py --fem tools/reference/data/near_field_fem_chains.csv \
+        --out tools/reference/data/near_field_compare_chains.csv
 
 Each case is the FEM's arrangement in SI (a = 5 mm, Ms = 1.6e6 A/m, balls centred at
 (i - (N-1)/2)(2 + g) a on the z axis, H0 along z), solved by magsolve --method exact
 --force-model classic --mu-r 1000 (the Newton solution of the engine's tanh curve, the
 classic force -grad U*). Ratios of 1 are exact; the pair model's mark is 0.85-1.15 for pairs
-and 25 % for chains (end ball's force, chain moment). Prints markdown tables."""
+and 25 % for chains (end ball's force, chain moment). Prints markdown tables; a chain's
+"middle ball" is the innermost one of its upper half with a non-zero force."""
 import argparse
 import collections
 import csv
@@ -90,25 +94,25 @@ def main(argv=None):
     # markdown: pair cells (upper ball), then chains
     fields = sorted({r["H0_over_Ms"] for r in out})
     gaps = sorted({r["gap_over_a"] for r in out if r["N"] == 2}, reverse=True)
-    for m in MODELS:
+    for m in MODELS if gaps else ():
         print(f"\n{m} / FEM, two balls, force on the upper ball (rows g/a, columns H0/Ms):\n")
         def cell(g, h, m=m):
             r = next(r for r in out if r["N"] == 2 and r["gap_over_a"] == g and r["H0_over_Ms"] == h)
             return nfcommon.pair_mark(r[f"F_{m}_over_fem"])
         print("\n".join(nfcommon.gap_field_table(gaps, fields, cell)))
-    for n in sorted({r["N"] for r in out if r["N"] > 2}):
-        print(f"\nchain of {n} (g = 0.003a), model / FEM:\n")
+    for n, gap in sorted({(r["N"], r["gap_over_a"]) for r in out if r["N"] > 2}, key=lambda k: (-k[1], k[0])):
+        print(f"\nchain of {n} (g = {gap:g}a), model / FEM:\n")
         print("| H0/Ms | " + " | ".join(f"{q} {m}" for q in ("end ball", "middle ball", "moment") for m in MODELS) + " |")
         print("|---" * 7 + "|")
         for h in fields:
-            rs = [r for r in out if r["N"] == n and r["H0_over_Ms"] == h]
+            rs = [r for r in out if r["N"] == n and r["gap_over_a"] == gap and r["H0_over_Ms"] == h]
             end = max(rs, key=lambda r: r["ball"])
             mid = min(rs, key=lambda r: r["ball"])
             cells = []
             for label, q, r_ in (("end", "F", end), ("mid", "F", mid), ("moment", "moment", end)):
                 for m in MODELS:
                     if label == "mid" and mid is end:
-                        cells.append("0 (symmetry)")  # N = 3: the middle ball is the central one
+                        cells.append("—")  # N = 3: the middle ball is the central one (0 by symmetry)
                         continue
                     v = r_[f"{q}_{m}_over_fem"]
                     cells.append(f"**{v:.2f}**" if abs(v - 1) > 0.25 else f"{v:.2f}")
