@@ -261,7 +261,7 @@ std::vector<OptionSpec> build() {
       named(MEMBER(magnetics.field.near_field.model), mag::NearField::Dipole, mag::kNearFieldNames,
             "near-field model",
             "near field of touching iron balls: dipole = one point dipole each; pair = exact two-sphere "
-            "couplings for pairs closer than a gap of 2 radii, at a wider gap as the contact saturates and "
+            "couplings for pairs closer than a gap of 2 radii, at a wider gap as the balls' flux saturates the contact and "
             "weaker where a chain's contacts share the flux "
             "(magnetics/near_field.hpp); pair needs the classic force")
           .was("near_field").flag("--near-field"),

@@ -59,7 +59,10 @@ double Simulation::coenergy(const mag::Magnetization& mz) const {
   if (m.resolved.force == mag::ForceModel::ZeemanTotal)
     return mag::zeeman_total_energy(moments_, mz, m.resolved.curve, ws_.mag.H,
                                     ws_.mag.total.perm, ws_.mag.total.Hp);
-  return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H);
+  if (m.options.magnetics.field.near_field.model == mag::NearField::Dipole)
+    return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H);
+  mag::NearFieldWorkspace nws;  // the pair list of these positions (const: not the step's cache)
+  return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H, m.options.magnetics.field.near_field, &nws);
 }
 
 void Simulation::solve_magnetics(mag::Magnetization* mz, bool solve, long n) {

@@ -11,6 +11,7 @@
 #pragma once
 
 #include "magnetics/moments.hpp"
+#include "magnetics/near_field.hpp"
 
 #include <vector>
 
@@ -30,6 +31,15 @@ double magnetic_coenergy(const MomentDesc& set, const Magnetization& mz, Curve c
                          const std::vector<Vec3>& H);
 inline double magnetic_coenergy(const MomentSet& set, Curve curve, const std::vector<Vec3>& H) {
   return magnetic_coenergy(set, set, curve, H);
+}
+/// U* as above with the near-field pair model on: its energy is not bilinear in the moments,
+/// so ½ m·H over the fields misses near_field_coenergy_excess. The same as the form above for
+/// NearField::Dipole.
+inline double magnetic_coenergy(const MomentDesc& set, const Magnetization& mz, Curve curve,
+                                const std::vector<Vec3>& H, const NearFieldOptions& near,
+                                NearFieldWorkspace* ws) {
+  const double U = magnetic_coenergy(set, mz, curve, H);
+  return H.size() == set.size() ? U + near_field_coenergy_excess(set, mz, near, ws) : U;
 }
 
 }  // namespace magsim::mag

@@ -3,7 +3,9 @@
 // H is affine in the induced magnetizations: H_j = Hb_j + Σ_{i≠j} G(p_j − p_i) V_i M_i,
 // with Hb the external field plus the permanent moments' fields and
 // G(r) = (1/4π)(3 r rᵀ − q I)/q^{5/2} (eq. 1 as a matrix). So ∂R/∂M = I − A T with
-// A = blockdiag(∂f/∂H) and T the dense interaction matrix.
+// A = blockdiag(∂f/∂H) and T the dense interaction matrix. The near-field pair model's field
+// (near_field.hpp) is not affine in M: it is evaluated at each iterate, and its blocks
+// ∂H/∂M join T in the Newton matrix.
 #include "magnetics/ground_truth.hpp"
 
 #include "magnetics/curves.hpp"
@@ -57,24 +59,31 @@ Problem build(const MomentDesc& set, const FieldOptions& field) {
       P.T.block<3, 3>(3 * a, 3 * b) = G * set.volume[i];
     }
   }
-  // the near-field pair model's couplings (near_field.hpp), affine in M as the dipoles are
-  std::vector<NearCoupling> near;
-  NearFieldWorkspace nws;
-  near_field_couplings(set, field.near_field, &nws, &near);
-  if (!near.empty()) {
-    std::vector<int> slot(set.size(), -1);
-    for (int a = 0; a < k; ++a) slot[P.idx[a]] = a;
-    for (const NearCoupling& c : near) {
-      P.T.block<3, 3>(3 * slot[c.i], 3 * slot[c.j]) += c.K * set.volume[c.j];
-      P.T.block<3, 3>(3 * slot[c.j], 3 * slot[c.i]) += c.K * set.volume[c.i];
-    }
-  }
   return P;
 }
 
-Eigen::VectorXd residual(const MomentDesc& set, const Problem& P, Curve curve,
+// The pair model's field at the iterate M (scratch: a magnetization holding M, and the
+// field of every moment)
+struct Near {
+  const NearFieldOptions* opt;
+  NearFieldWorkspace ws;
+  Magnetization mz;
+  std::vector<Vec3> H;
+  bool on() const { return opt->model == NearField::Pair; }
+  void load(const Problem& P, const Eigen::VectorXd& M) {
+    for (std::size_t a = 0; a < P.idx.size(); ++a) mz.M[P.idx[a]] = M.segment<3>(3 * a);
+  }
+};
+
+Eigen::VectorXd residual(const MomentDesc& set, const Problem& P, Curve curve, Near* nf,
                          const Eigen::VectorXd& M, Eigen::VectorXd* H) {
   *H = P.Hb + P.T * M;
+  if (nf->on()) {
+    nf->load(P, M);
+    nf->H.assign(set.size(), Vec3::Zero());
+    add_near_field(set, nf->mz, *nf->opt, &nf->ws, &nf->H);
+    for (std::size_t a = 0; a < P.idx.size(); ++a) H->segment<3>(3 * a) += nf->H[P.idx[a]];
+  }
   Eigen::VectorXd R(M.size());
   for (std::size_t a = 0; a < P.idx.size(); ++a) {
     const Vec3 Ha = H->segment<3>(3 * a);
@@ -97,7 +106,11 @@ ExactStats solve_exact(const MomentDesc& set, Magnetization* mz, Curve curve,
   }
   Eigen::VectorXd M(3 * k), H;
   for (int a = 0; a < k; ++a) M.segment<3>(3 * a) = mz->M[P.idx[a]];
-  Eigen::VectorXd R = residual(set, P, curve, M, &H);
+  Near nf{&field.near_field, {}, *mz, {}};
+  std::vector<int> slot(set.size(), -1);
+  for (int a = 0; a < k; ++a) slot[P.idx[a]] = a;
+  std::vector<NearBlock> blocks;
+  Eigen::VectorXd R = residual(set, P, curve, &nf, M, &H);
   auto rel = [&](const Eigen::VectorXd& r, const Eigen::VectorXd& m) {
     const double mn = m.norm();
     return mn > 0 ? r.norm() / mn : r.norm();
@@ -109,8 +122,13 @@ ExactStats solve_exact(const MomentDesc& set, Magnetization* mz, Curve curve,
       st.converged = true;
       break;
     }
-    // Newton matrix I − A T
+    // Newton matrix I − A (T + ∂H_near/∂M)
     Jac = -P.T;
+    if (nf.on()) {
+      nf.load(P, M);
+      near_field_jacobian(set, nf.mz, *nf.opt, &nf.ws, &blocks);
+      for (const NearBlock& b : blocks) Jac.block<3, 3>(3 * slot[b.a], 3 * slot[b.b]) -= b.D;
+    }
     for (int a = 0; a < k; ++a) {
       const Mat3 A = curve_dMdH(curve, H.segment<3>(3 * a), set.Ms[P.idx[a]]);
       Jac.middleRows<3>(3 * a) = A * Jac.middleRows<3>(3 * a);
@@ -123,7 +141,7 @@ ExactStats solve_exact(const MomentDesc& set, Magnetization* mz, Curve curve,
     Eigen::VectorXd Mn, Hn, Rn;
     for (int ls = 0; ls < 40; ++ls) {
       Mn = M + lam * delta;
-      Rn = residual(set, P, curve, Mn, &Hn);
+      Rn = residual(set, P, curve, &nf, Mn, &Hn);
       if (Rn.norm() < (1.0 - 1e-4 * lam) * r0 || Rn.norm() == 0.0) break;
       lam *= 0.5;
     }

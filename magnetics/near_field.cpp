@@ -3,8 +3,6 @@
 #include "magnetics/near_field.hpp"
 #include "magnetics/det_math.hpp"
 
-#include "magnetics/dipole_field.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -95,33 +93,38 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
   perp2_ = spline_second(perp_, table_step());
 }
 
-// G = g_e(g) + s κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = s κ q h^{q−1}
-double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh, double s) {
+// G = g_e(g) + κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = κ q h^{q−1}
+double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh) {
   double dge = 0;
   const double ge = pair_effective_gap(g, &dge);
-  const double w = h > 0 ? s * kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
   if (dG_dg) *dG_dg = dge;
   if (dG_dh) *dG_dh = h > 0 ? kPairWidenPower * w / h : 0.0;
   return ge + w;
 }
 
-// Δt(g, h, s) = spline(ln G(g, h, s)); ∂Δt/∂g = spline'(x) (∂G/∂g)/G, and so for h and s
-// (∂G/∂s = κ h^q)
-PairCoupling PairCouplingTable::at(double g, double h, double s) const {
+// h = ζ/(3 √(1 − ζ²)), dh/dζ = (1 − ζ²)^{−3/2}/3
+double pair_flux_field(double zeta, double* dh_dzeta) {
+  constexpr double kZetaMax = 1.0 - 1e-9;
+  const double z = std::clamp(zeta, 0.0, kZetaMax);
+  const double c = 1.0 - z * z, r = std::sqrt(c);
+  if (dh_dzeta) *dh_dzeta = zeta < kZetaMax ? 1.0 / (3.0 * c * r) : 0.0;
+  return z / (3.0 * r);
+}
+
+// Δt(g, h) = spline(ln G(g, h)); ∂Δt/∂g = spline'(x) (∂G/∂g)/G, and so for h
+PairCoupling PairCouplingTable::at(double g, double h) const {
   double dGg = 0, dGh = 0;
-  const double G = pair_widened_gap(g, h, &dGg, &dGh, s);
-  const double dGs = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  const double G = pair_widened_gap(g, h, &dGg, &dGh);
   const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
   spline_eval(par_, par2_, x, &c.par, &d);
   c.dpar = d * dGg / G;
   c.dpar_dh = d * dGh / G;
-  c.dpar_ds = d * dGs / G;
   spline_eval(perp_, perp2_, x, &c.perp, &d);
   c.dperp = d * dGg / G;
   c.dperp_dh = d * dGh / G;
-  c.dperp_ds = d * dGs / G;
   return c;
 }
 
@@ -162,9 +165,6 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   ws->cached = false;
   ws->pairs.clear();
   ws->a.assign(n, 0.0);
-  ws->perm.clear();
-  for (std::size_t j = 0; j < n; ++j)
-    if (set.kind[j] == MomentKind::Permanent) ws->perm.push_back(static_cast<int>(j));
   // moments per group: a sphere is the only moment of its body
   std::unordered_map<std::int32_t, int> count;
   for (std::size_t j = 0; j < n; ++j)
@@ -224,26 +224,15 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   }
 }
 
-namespace {
-// Everything one pair's energy, field and forces need.
-struct PairGeometry {
-  Vec3 rhat;
-  double rho = 0, a = 0, g = 0;
-  double A = 0, B = 0, dA = 0, dB = 0;  // Δt∥/a³, Δt⊥/a³ at G and d/dρ
-  double hA = 0, hB = 0;                 // ∂A/∂h, ∂B/∂h
-  double nA = 0, nB = 0;                 // ∂A/∂ν, ∂B/∂ν
-  double S = 0, dS = 0;                  // switch and dS/dρ
-  double w = 1, dw = 0;                  // ν^−β and d/dν
-  double dSc = 0;                        // dS_c/dρ of the pair's own gap
-  Vec3 Hhat = Vec3::Zero();              // direction of H_app
-  double Ms = 0;
-  Mat3 Japp = Mat3::Zero();              // ∂H_app/∂x at the midpoint
-  Vec3 mid = Vec3::Zero();
-};
 
-PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
-                      const NearFieldWorkspace& ws, const NearPair& p, bool with_jacobian) {
-  PairGeometry q;
+namespace {
+bool same_description(const MomentDesc& a, const MomentDesc& b) {
+  return a.position == b.position && a.volume == b.volume && a.radius == b.radius &&
+         a.group == b.group && a.kind == b.kind && a.Ms == b.Ms;
+}
+
+PairStatic static_of(const MomentDesc& set, const NearFieldWorkspace& ws, const NearPair& p) {
+  PairStatic q;
   const Vec3 r = set.position[p.i] - set.position[p.j];
   q.rho = r.norm();
   q.a = ws.a[p.i];
@@ -258,139 +247,171 @@ PairGeometry geometry(const MomentDesc& set, const PairCouplingTable& tab,
   const double nu = std::max(1.0, 1.0 + 0.5 * (ws.count[p.i] + ws.count[p.j]) - Sc);
   q.w = dmath::pow(nu, -kPairShareCoupling);
   q.dw = -kPairShareCoupling * q.w / nu;
-  const double sh = dmath::pow(nu, kPairShareWiden), dsh = kPairShareWiden * sh / nu;
-  // H_app: the permanent moments' field and H0 at the midpoint
-  q.mid = 0.5 * (set.position[p.i] + set.position[p.j]);
-  Vec3 H = set.H0;
-  for (const int k : ws.perm) {
-    const Vec3& m = set.m_perm[k];
-    H += dipole_field(q.mid - set.position[k], m);
-    if (with_jacobian) q.Japp += dipole_jacobian(q.mid - set.position[k], m);
-  }
-  q.Ms = 0.5 * (set.Ms[p.i] + set.Ms[p.j]);
-  const double Hn = H.norm();
-  if (Hn > 0) q.Hhat = H / Hn;
-  const PairCoupling c = tab.at(q.g, q.Ms > 0 ? Hn / q.Ms : 0.0, sh);
-  const double a3 = q.a * q.a * q.a;
-  q.A = c.par / a3;
-  q.B = c.perp / a3;
-  q.dA = c.dpar / (a3 * q.a);
-  q.dB = c.dperp / (a3 * q.a);
-  q.hA = c.dpar_dh / a3;
-  q.hB = c.dperp_dh / a3;
-  q.nA = c.dpar_ds * dsh / a3;
-  q.nB = c.dperp_ds * dsh / a3;
   return q;
 }
 
-}  // namespace
-
-namespace {
-bool same_description(const MomentDesc& a, const MomentDesc& b) {
-  return a.position == b.position && a.m_perm == b.m_perm && a.volume == b.volume &&
-         a.radius == b.radius && a.group == b.group && a.kind == b.kind && a.Ms == b.Ms &&
-         a.H0 == b.H0;
-}
-
-// K = S ν^−β ΔT(r) of every near pair, rebuilt only when the description or μr changed
-const std::vector<NearCoupling>& couplings_of(const MomentDesc& set, const NearFieldOptions& opt,
-                                              NearFieldWorkspace* ws) {
-  if (ws->cached && ws->key_mu_r == opt.mu_r && same_description(ws->key, set)) return ws->couplings;
+// The pair geometry of `set`, rebuilt only when its description changed
+const std::vector<PairStatic>& statics_of(const MomentDesc& set, NearFieldWorkspace* ws) {
+  if (ws->cached && same_description(ws->key, set)) return ws->statics;
   find_near_pairs(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  ws->couplings.clear();
-  for (const NearPair& p : ws->pairs) {
-    const PairGeometry q = geometry(set, tab, *ws, p, false);
-    const Mat3 K = q.S * q.w * ((q.A - q.B) * (q.rhat * q.rhat.transpose()) + q.B * Mat3::Identity());
-    ws->couplings.push_back({p.i, p.j, K});
-  }
+  ws->statics.clear();
+  for (const NearPair& p : ws->pairs) ws->statics.push_back(static_of(set, *ws, p));
   ws->key = set;
-  ws->key_mu_r = opt.mu_r;
   ws->cached = true;
-  return ws->couplings;
+  return ws->statics;
 }
+
+// One pair at given moments: W = (A − B) P + B Q (E = −μ0 S w W), A, B = Δt∥, Δt⊥ / a³ at
+// G(g, h(ζ̄)), P = (m_i·r̂)(m_j·r̂), Q = m_i·m_j, ζ̄ = (ζ_i + ζ_j)/2, ζ = |m|/(V Ms).
+struct PairState {
+  double A = 0, B = 0, dA = 0, dB = 0;  // and their ρ-derivatives
+  double W = 0, Wh = 0;                 // W and ∂W/∂h
+  double hz = 0, zeta = 0;              // dh/dζ̄, ζ̄
+  double zi = 0, zj = 0;                // ζ_i, ζ_j
+};
+
+PairState state_of(const PairStatic& q, const PairCouplingTable& tab, const Vec3& mi, const Vec3& mj,
+                   double ci, double cj) {
+  // ci, cj = 1/(V Ms) of each ball
+  PairState s;
+  s.zi = mi.norm() * ci;
+  s.zj = mj.norm() * cj;
+  s.zeta = 0.5 * (s.zi + s.zj);
+  const double h = pair_flux_field(s.zeta, &s.hz);
+  const PairCoupling c = tab.at(q.g, h);
+  const double a3 = q.a * q.a * q.a;
+  s.A = c.par / a3;
+  s.B = c.perp / a3;
+  s.dA = c.dpar / (a3 * q.a);
+  s.dB = c.dperp / (a3 * q.a);
+  const double P = mi.dot(q.rhat) * mj.dot(q.rhat), Q = mi.dot(mj);
+  s.W = (s.A - s.B) * P + s.B * Q;
+  s.Wh = (c.dpar_dh - c.dperp_dh) / a3 * P + c.dperp_dh / a3 * Q;
+  return s;
+}
+
+// −(1/μ0) ∂E/∂m_i = S w [(A − B)(m_j·r̂) r̂ + B m_j + W_h (dh/dζ̄) ½ m̂_i/(V_i Ms_i)], and so for j
+void pair_field(const PairStatic& q, const PairCouplingTable& tab, const Vec3& mi, const Vec3& mj,
+                double ci, double cj, Vec3* Hi, Vec3* Hj) {
+  const PairState s = state_of(q, tab, mi, mj, ci, cj);
+  const double k = q.S * q.w, sat = 0.5 * k * s.Wh * s.hz;
+  *Hi = k * ((s.A - s.B) * mj.dot(q.rhat) * q.rhat + s.B * mj);
+  *Hj = k * ((s.A - s.B) * mi.dot(q.rhat) * q.rhat + s.B * mi);
+  const double ni = mi.norm(), nj = mj.norm();
+  if (ni > 0) *Hi += sat * ci / ni * mi;
+  if (nj > 0) *Hj += sat * cj / nj * mj;
+}
+
+double inv_vms(const MomentDesc& set, int j) { return 1.0 / (set.volume[j] * set.Ms[j]); }
 }  // namespace
 
-void near_field_couplings(const MomentDesc& set, const NearFieldOptions& opt,
-                          NearFieldWorkspace* ws, std::vector<NearCoupling>* out) {
+void near_field_jacobian(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
+                         NearFieldWorkspace* ws, std::vector<NearBlock>* out) {
   out->clear();
   if (opt.model != NearField::Pair) return;
-  *out = couplings_of(set, opt, ws);
+  const std::vector<PairStatic>& st = statics_of(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  for (std::size_t n = 0; n < st.size(); ++n) {
+    const int i = ws->pairs[n].i, j = ws->pairs[n].j;
+    const int ids[2] = {i, j};
+    const double ci = inv_vms(set, i), cj = inv_vms(set, j);
+    Mat3 D[2][2];
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 3; ++c) {
+        const double e = 1e-6 * set.Ms[ids[b]], V = set.volume[ids[b]];
+        Vec3 m[2][2] = {{moment(set, mz, i), moment(set, mz, j)}, {moment(set, mz, i), moment(set, mz, j)}};
+        m[0][b][c] += e * V;
+        m[1][b][c] -= e * V;
+        Vec3 Hp[2], Hm[2];
+        pair_field(st[n], tab, m[0][0], m[0][1], ci, cj, &Hp[0], &Hp[1]);
+        pair_field(st[n], tab, m[1][0], m[1][1], ci, cj, &Hm[0], &Hm[1]);
+        for (int a = 0; a < 2; ++a) D[a][b].col(c) = (Hp[a] - Hm[a]) / (2 * e);
+      }
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) out->push_back({ids[a], ids[b], D[a][b]});
+  }
 }
 
 void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
                     NearFieldWorkspace* ws, std::vector<Vec3>* H) {
   if (opt.model != NearField::Pair) return;
-  for (const NearCoupling& c : couplings_of(set, opt, ws)) {
-    (*H)[c.i] += c.K * moment(set, mz, c.j);
-    (*H)[c.j] += c.K * moment(set, mz, c.i);
+  const std::vector<PairStatic>& st = statics_of(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  for (std::size_t n = 0; n < st.size(); ++n) {
+    const int i = ws->pairs[n].i, j = ws->pairs[n].j;
+    Vec3 Hi, Hj;
+    pair_field(st[n], tab, moment(set, mz, i), moment(set, mz, j), inv_vms(set, i), inv_vms(set, j), &Hi, &Hj);
+    (*H)[i] += Hi;
+    (*H)[j] += Hj;
   }
 }
 
-// E_ij = −μ0 m_iᵀ K m_j,  K = S ν^−β ΔT
+// E_ij = −μ0 S w W
 double near_field_energy(const MomentDesc& set, const Magnetization& mz,
                          const NearFieldOptions& opt, NearFieldWorkspace* ws) {
   if (opt.model != NearField::Pair) return 0.0;
+  const std::vector<PairStatic>& st = statics_of(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
   double E = 0;
-  for (const NearCoupling& c : couplings_of(set, opt, ws))
-    E -= kMu0 * moment(set, mz, c.i).dot(c.K * moment(set, mz, c.j));
+  for (std::size_t n = 0; n < st.size(); ++n) {
+    const int i = ws->pairs[n].i, j = ws->pairs[n].j;
+    const PairState s = state_of(st[n], tab, moment(set, mz, i), moment(set, mz, j), inv_vms(set, i), inv_vms(set, j));
+    E -= kMu0 * st[n].S * st[n].w * s.W;
+  }
   return E;
 }
 
-// E = −μ0 S(g) w W,  w = ν^−β,  W = (A − B) P + B Q,  P = (m_i·r̂)(m_j·r̂),  Q = m_i·m_j,
-// A, B = Δt∥, Δt⊥ / a³ at G(g, h, ν); r = p_i − p_j, ρ = |r|, h = |H_app(x)|/Ms at x = (p_i + p_j)/2:
+// ½ μ0 (m_i·H_i + m_j·H_j) of pair_field is −E_ij + ½ μ0 S w W_h (dh/dζ̄) ζ̄, so the excess
+// E_ij + ½ μ0 Σ m·H_near is ½ μ0 S w W_h (dh/dζ̄) ζ̄ per pair
+double near_field_coenergy_excess(const MomentDesc& set, const Magnetization& mz,
+                                  const NearFieldOptions& opt, NearFieldWorkspace* ws) {
+  if (opt.model != NearField::Pair) return 0.0;
+  const std::vector<PairStatic>& st = statics_of(set, ws);
+  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  double X = 0;
+  for (std::size_t n = 0; n < st.size(); ++n) {
+    const int i = ws->pairs[n].i, j = ws->pairs[n].j;
+    const PairState s = state_of(st[n], tab, moment(set, mz, i), moment(set, mz, j), inv_vms(set, i), inv_vms(set, j));
+    X += 0.5 * kMu0 * st[n].S * st[n].w * s.Wh * s.hz * s.zeta;
+  }
+  return X;
+}
+
+// E = −μ0 S(g) w W at fixed moments (so fixed ζ̄ and h): r = p_i − p_j, ρ = |r|,
 //   ∂W/∂r = [(∂A/∂ρ − ∂B/∂ρ) P + ∂B/∂ρ Q] r̂ + (A − B) ∇_r P,
 //   ∇_r P = [(m_j·r̂)(m_i − (m_i·r̂) r̂) + (m_i·r̂)(m_j − (m_j·r̂) r̂)]/ρ,
-//   ∇_x (S w W) = S w W_h J_app Ĥ / Ms,  W_h = (∂A/∂h − ∂B/∂h) P + ∂B/∂h Q  (J_app symmetric),
-//   F_i = μ0 w [S ∂W/∂r + W dS/dρ r̂] + ½ μ0 ∇_x (S w W),  F_j = −μ0 w [S ∂W/∂r + W dS/dρ r̂] + ½ μ0 ∇_x (S w W),
-//   permanent k (H_app ∋ h(x − p_k, m_k)):  F_k = −μ0 S w W_h/Ms J_k Ĥ,
-//                                           τ_k = μ0 S w W_h/Ms m_k × h(x − p_k, Ĥ);
-// through ν_p = 1 + (n_i + n_j)/2 − S_c(g_p), with Λ_p = ∂(S w W)/∂ν = S (w' W + w W_ν) and
+//   F_i = μ0 w [S ∂W/∂r + W dS/dρ r̂],  F_j = −F_i;
+// through ν_p = 1 + (n_i + n_j)/2 − S_c(g_p), with Λ_p = ∂(S w W)/∂ν = S w' W and
 // λ_b = ½ Σ_{p ∋ b} Λ_p: every near pair c = (k, l) (p's own gap cancels in ν_p) adds
 //   F_k = μ0 (λ_k + λ_l − Λ_c) (dS_c/dρ) r̂_c,  F_l = −F_k.
 void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
                            const NearFieldOptions& opt, NearFieldWorkspace* ws,
-                           std::vector<Vec3>* F, std::vector<Vec3>* tau) {
+                           std::vector<Vec3>* F, std::vector<Vec3>* /*tau*/) {
   if (opt.model != NearField::Pair) return;
-  couplings_of(set, opt, ws);  // the pair list of `set` (compute_fields has made it already)
+  const std::vector<PairStatic>& st = statics_of(set, ws);
   const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  std::vector<double> Lam(ws->pairs.size(), 0.0), lam(set.size(), 0.0);
-  std::vector<Vec3> rhat(ws->pairs.size());
-  std::vector<double> dSc(ws->pairs.size(), 0.0);
-  for (std::size_t n = 0; n < ws->pairs.size(); ++n) {
+  std::vector<double> Lam(st.size(), 0.0), lam(set.size(), 0.0);
+  for (std::size_t n = 0; n < st.size(); ++n) {
+    const PairStatic& q = st[n];
     const NearPair& p = ws->pairs[n];
-    const PairGeometry q = geometry(set, tab, *ws, p, true);
-    rhat[n] = q.rhat;
-    dSc[n] = q.dSc;
     if (q.S == 0 && q.dS == 0) continue;
     const Vec3 mi = moment(set, mz, p.i), mj = moment(set, mz, p.j);
+    const PairState s = state_of(q, tab, mi, mj, inv_vms(set, p.i), inv_vms(set, p.j));
     const double ui = mi.dot(q.rhat), uj = mj.dot(q.rhat);
     const double P = ui * uj, Q = mi.dot(mj);
-    const double W = (q.A - q.B) * P + q.B * Q;
     const Vec3 dP = (uj * (mi - ui * q.rhat) + ui * (mj - uj * q.rhat)) / q.rho;
-    const Vec3 dW = ((q.dA - q.dB) * P + q.dB * Q) * q.rhat + (q.A - q.B) * dP;
-    const double Wh = (q.hA - q.hB) * P + q.hB * Q;
-    const double Wn = (q.nA - q.nB) * P + q.nB * Q;
-    Lam[n] = q.S * (q.dw * W + q.w * Wn);
+    const Vec3 dW = ((s.dA - s.dB) * P + s.dB * Q) * q.rhat + (s.A - s.B) * dP;
+    Lam[n] = q.S * q.dw * s.W;
     lam[p.i] += 0.5 * Lam[n];
     lam[p.j] += 0.5 * Lam[n];
-    const double kh = q.Ms > 0 ? q.S * q.w * Wh / q.Ms : 0.0;  // ∂(S w W)/∂|H_app|
-    const Vec3 dx = kh * (q.Japp * q.Hhat);
-    const Vec3 radial = q.w * (q.S * dW + W * q.dS * q.rhat);
-    (*F)[p.i] += kMu0 * (radial + 0.5 * dx);
-    (*F)[p.j] += kMu0 * (-radial + 0.5 * dx);
-    if (kh == 0) continue;
-    for (const int k : ws->perm) {
-      const Vec3& mk = set.m_perm[k];
-      const Vec3 rk = q.mid - set.position[k];
-      (*F)[k] -= kMu0 * kh * (dipole_jacobian(rk, mk) * q.Hhat);
-      if (tau) (*tau)[k] += kMu0 * kh * mk.cross(dipole_field(rk, q.Hhat));
-    }
+    const Vec3 radial = kMu0 * q.w * (q.S * dW + s.W * q.dS * q.rhat);
+    (*F)[p.i] += radial;
+    (*F)[p.j] -= radial;
   }
-  for (std::size_t n = 0; n < ws->pairs.size(); ++n) {
-    if (dSc[n] == 0) continue;
+  for (std::size_t n = 0; n < st.size(); ++n) {
+    if (st[n].dSc == 0) continue;
     const NearPair& p = ws->pairs[n];
-    const Vec3 f = kMu0 * (lam[p.i] + lam[p.j] - Lam[n]) * dSc[n] * rhat[n];
+    const Vec3 f = kMu0 * (lam[p.i] + lam[p.j] - Lam[n]) * st[n].dSc * st[n].rhat;
     (*F)[p.i] += f;
     (*F)[p.j] -= f;
   }

@@ -31,7 +31,7 @@ double coenergy_solved(MomentSet s, Curve c, const FieldOptions& f) {
   FieldWorkspace ws;
   std::vector<Vec3> H;
   compute_fields(s, f, &H, nullptr, &ws);
-  return magnetic_coenergy(s, c, H);
+  return magnetic_coenergy(s, s, c, H, f.near_field, &ws.near);
 }
 
 // forces and torques of `model` at the exact solution of s

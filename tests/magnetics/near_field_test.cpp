@@ -52,7 +52,7 @@ double coenergy_at(MomentSet s, const FieldOptions& f) {
   FieldWorkspace ws;
   std::vector<Vec3> H;
   compute_fields(s, f, &H, nullptr, &ws);
-  return magnetic_coenergy(s, Curve::Tanh, H);
+  return magnetic_coenergy(s, s, Curve::Tanh, H, f.near_field, &ws.near);
 }
 
 // −dU*/dt by central differences of step d, Richardson-extrapolated from d and d/2
@@ -69,10 +69,9 @@ double minus_dU(const MomentSet& s, const FieldOptions& f, double d,
 }
 
 // A tilted pair at gap g (radii) and a bent chain of four with gaps g, 1.5g, 0.7 (the last in
-// the contact count's step; the first two balls' second neighbour in the cut-off step), a magnet below them
-// and H0 of h Ms. The
-// magnet adds a fifth of h Ms at 25 mm, so H_app varies across the balls (its gradient is
-// what moves G on the magnet's and the balls' forces).
+// the contact count's step; the first two balls' second neighbour in the cut-off step), a
+// magnet below them and H0 of h Ms. The magnet adds a fifth of h Ms at 25 mm, so the balls'
+// magnetizations, which set each contact's widened gap, differ from ball to ball.
 MomentSet pair_and_chain(double g, double h) {
   MomentSet s;
   const double a = kBallRadius;
@@ -225,7 +224,7 @@ TEST_CASE("pair model: the coupling, switch and widened gap are smooth and as do
   // the widened gap: its h-derivatives, beyond the table's last node (G > 2.2) too
   for (double g : {3e-3, 0.05, 1.3}) {
     for (double h : {1e-3, 0.02, 0.5, 3.0}) {
-      const double e = 1e-7 * h;
+      const double e = 1e-4 * h;  // Δt moves by ~1e-13 of itself per 1e-7 h at h = 0.001
       const PairCoupling c = tab.at(g, h), cp = tab.at(g, h + e), cm = tab.at(g, h - e);
       INFO("g " << g << " h " << h);
       CHECK(c.dpar_dh == Approx((cp.par - cm.par) / (2 * e)).epsilon(1e-5).margin(1e-12));
@@ -242,6 +241,21 @@ TEST_CASE("pair model: the coupling, switch and widened gap are smooth and as do
     CHECK(lo.par == Approx(hi.par).epsilon(1e-7));
     CHECK(lo.dpar_dh == Approx(hi.dpar_dh).epsilon(1e-6));
   }
+  // the saturation field of the balls' magnetization: ζ/3 to first order (a lone ball's
+  // linear law ζ = 3h), its derivative, unbounded towards saturation, held past ζ ≈ 1
+  CHECK(pair_flux_field(0.0) == 0.0);
+  CHECK(pair_flux_field(1e-4) == Approx(1e-4 / 3).epsilon(1e-8));
+  for (double z : {0.01, 0.3, 0.7, 0.95, 0.999}) {
+    double d = 0;
+    pair_flux_field(z, &d);
+    const double e = 1e-6 * (1 - z);
+    CHECK(d == Approx((pair_flux_field(z + e) - pair_flux_field(z - e)) / (2 * e)).epsilon(1e-6));
+  }
+  CHECK(pair_flux_field(0.999) > 7.0);
+  double dsat = 1;
+  CHECK(pair_flux_field(1.0, &dsat) == pair_flux_field(1.5));
+  CHECK(dsat == 0.0);
+  CHECK(std::isfinite(pair_flux_field(1.0)));
   // the contact count: 1 to g = 0.5, 0 from g = 1; a straight 3-chain counts 1, 2, 1
   CHECK(pair_count_switch(0.5) == 1.0);
   CHECK(pair_count_switch(1.0) == 0.0);
@@ -271,8 +285,9 @@ TEST_CASE("pair model: the coupling, switch and widened gap are smooth and as do
   CHECK(validate(o).empty());
 }
 
-TEST_CASE("pair model: the cached couplings follow the description", "[near_field]") {
-  // one workspace through three descriptions: each gives the field a fresh workspace gives
+TEST_CASE("pair model: the cached geometry follows the description", "[near_field]") {
+  // one workspace through descriptions and magnetizations: each gives the field and energy a
+  // fresh workspace gives
   MomentSet s;
   const double a = kBallRadius;
   s.add_induced(Vec3(0, 0, 0), ball_volume(), kIronMs);
@@ -288,24 +303,28 @@ TEST_CASE("pair model: the cached couplings follow the description", "[near_fiel
     add_near_field(t, t, o, ws, &H);
     return H;
   };
-  MomentSet moved = s, turned = s;
+  MomentSet moved = s, turned = s, stronger = s;
   moved.position[1].z() += 0.1 * a;
   turned.m_perm[3] = Vec3(0, 1.5, 1.0);
-  for (const MomentSet* t : {&s, &moved, &s, &turned}) {
+  stronger.set_magnetization(1, Vec3(1e5, 4e5, 6e5));
+  for (const MomentSet* t : {&s, &moved, &s, &turned, &stronger}) {
     NearFieldWorkspace fresh;
     const auto Hr = field(*t, &reused), Hf = field(*t, &fresh);
     for (std::size_t j = 0; j < t->size(); ++j) CHECK(Hr[j] == Hf[j]);
     CHECK(near_field_energy(*t, *t, o, &reused) == near_field_energy(*t, *t, o, &fresh));
   }
   CHECK(field(s, &reused)[0] != field(moved, &reused)[0]);
-  CHECK(field(s, &reused)[0] != field(turned, &reused)[0]);
+  // the saturation reads the balls' own magnetization, not the magnet's field
+  CHECK(field(s, &reused)[0] == field(turned, &reused)[0]);
+  CHECK(field(s, &reused)[0] != field(stronger, &reused)[0]);
 }
 
 TEST_CASE("pair model: forces and the magnet's torque are -grad U* across the widened gap",
           "[near_field]") {
   // central differences of U* (every magnetization re-solved), against the classic forces on
   // every ball and the magnet and the magnet's torque; gaps 0.003a–0.3a, H0 from the linear
-  // range through the knee to saturation (G = g_e + κ h^q from g_e to past the table's end)
+  // range through the knee to saturation (G = g_e + κ h(ζ̄)^q from g_e to past the table's
+  // end; ζ̄ moves with every re-solved magnetization, so this holds the saturation term too)
   FieldOptions f = with_model(NearField::Pair);
   double worst_F = 0, worst_T = 0;
   for (double g : {0.003, 0.03, 0.3}) {

@@ -5,7 +5,8 @@ check half. Neither is in the engine (tools/findings/near_field_reference.md say
 
     /usr/bin/python3 tools/reference/near_field_widen_trials.py [--fem tools/reference/data/near_field_fem.csv]
 
-The engine's model (candidate C): Dt at G = g_e + kappa nu^gamma h^q, coupling nu^-beta,
+Candidate C (the engine's model until the saturation read the balls' own flux;
+near_field_flux_fit.py fits the present one): Dt at G = g_e + kappa nu^gamma h^q, coupling nu^-beta,
 kappa = 0.553, q = 1.22, beta = 0.4, gamma = 1, nu from the contact count S_c (1 to g = 0.5,
 0 from g = 1).
 
@@ -36,7 +37,7 @@ import near_field_fade as nf  # noqa: E402
 
 A, MS, MU0, V = nf.A, nf.MS, nf.MU0, nf.V
 HERE = os.path.dirname(os.path.abspath(__file__))
-ENGINE = (0.553, 1.22, 1.0, 0.4, 1.0)  # kappa, q, p, beta, gamma
+ENGINE = (0.553, 1.22, 1.0, 0.4, 1.0)  # candidate C: kappa, q, p, beta, gamma
 
 
 def step(g, full, cut):
