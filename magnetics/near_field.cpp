@@ -30,18 +30,24 @@ std::vector<double> spline_second(const std::vector<double>& y, double h) {
   return m;
 }
 
-double table_step() {
-  return (dmath::log(kTableGapMax) - dmath::log(kTableGapMin)) / (kTableNodes - 1);
+// The table's nodes in x = ln g: first, last and step (computed once: every field evaluation
+// reads them for every near pair)
+struct TableAxis {
+  double x0, xn, h;
+};
+const TableAxis& table_axis() {
+  static const TableAxis t{dmath::log(kTableGapMin), dmath::log(kTableGapMax),
+                           (dmath::log(kTableGapMax) - dmath::log(kTableGapMin)) / (kTableNodes - 1)};
+  return t;
 }
+double table_step() { return table_axis().h; }
 
 // Value and derivative in x of the spline (y, m) at x = ln G. Beyond the last node x_n:
 // v = v_n e^{λ(x − x_n)}, λ = v'_n / v_n (a power law in G, C¹ at x_n: the table's corrections
 // fall as G^−6 there); held at v_n if the end did not fall.
 void spline_eval(const std::vector<double>& y, const std::vector<double>& m, double x,
                  double* v, double* dv) {
-  const double h = table_step();
-  const double x0 = dmath::log(kTableGapMin);
-  const double xn = dmath::log(kTableGapMax);
+  const double h = table_axis().h, x0 = table_axis().x0, xn = table_axis().xn;
   if (x > xn) {
     double vn = 0, dvn = 0;
     spline_eval(y, m, xn, &vn, &dvn);
@@ -114,16 +120,23 @@ double pair_flux_field(double zeta, double* dh_dzeta) {
 
 // Δt(g, h) = spline(ln G(g, h)); ∂Δt/∂g = spline'(x) (∂G/∂g)/G, and so for h
 PairCoupling PairCouplingTable::at(double g, double h) const {
-  double dGg = 0, dGh = 0;
-  const double G = pair_widened_gap(g, h, &dGg, &dGh);
+  double dge = 0;
+  const double ge = pair_effective_gap(g, &dge);
+  return at_effective(ge, dge, h);
+}
+
+// G = g_e + κ h^q as pair_widened_gap, from g_e and dg_e/dg
+PairCoupling PairCouplingTable::at_effective(double ge, double dge_dg, double h) const {
+  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  const double G = ge + w, dGh = h > 0 ? kPairWidenPower * w / h : 0.0;
   const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
   spline_eval(par_, par2_, x, &c.par, &d);
-  c.dpar = d * dGg / G;
+  c.dpar = d * dge_dg / G;
   c.dpar_dh = d * dGh / G;
   spline_eval(perp_, perp2_, x, &c.perp, &d);
-  c.dperp = d * dGg / G;
+  c.dperp = d * dge_dg / G;
   c.dperp_dh = d * dGh / G;
   return c;
 }
@@ -238,6 +251,7 @@ PairStatic static_of(const MomentDesc& set, const NearFieldWorkspace& ws, const 
   q.a = ws.a[p.i];
   q.rhat = r / q.rho;
   q.g = q.rho / q.a - 2.0;
+  q.ge = pair_effective_gap(q.g, &q.dge);
   double dS_dg = 0;
   q.S = pair_switch(q.g, &dS_dg);
   q.dS = dS_dg / q.a;
@@ -278,7 +292,7 @@ PairState state_of(const PairStatic& q, const PairCouplingTable& tab, const Vec3
   s.zj = mj.norm() * cj;
   s.zeta = 0.5 * (s.zi + s.zj);
   const double h = pair_flux_field(s.zeta, &s.hz);
-  const PairCoupling c = tab.at(q.g, h);
+  const PairCoupling c = tab.at_effective(q.ge, q.dge, h);
   const double a3 = q.a * q.a * q.a;
   s.A = c.par / a3;
   s.B = c.perp / a3;

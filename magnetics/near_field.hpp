@@ -109,6 +109,8 @@ class PairCouplingTable {
   explicit PairCouplingTable(double mu_r);
   double mu_r() const { return mu_r_; }
   PairCoupling at(double g, double h = 0.0) const;
+  /// The same from g_e(g) and dg_e/dg (a pair's cached effective gap).
+  PairCoupling at_effective(double ge, double dge_dg, double h) const;
 
  private:
   double mu_r_;
@@ -128,6 +130,7 @@ struct NearPair {
 struct PairStatic {
   Vec3 rhat = Vec3::Zero();  ///< (p_i − p_j)/ρ
   double rho = 0, a = 0, g = 0;
+  double ge = 0, dge = 0;  ///< g_e(g) and dg_e/dg
   double S = 0, dS = 0;  ///< the cut-off step and dS/dρ
   double w = 1, dw = 0;  ///< ν^−β and d/dν
   double dSc = 0;        ///< dS_c/dρ of the pair's own gap
