@@ -360,35 +360,37 @@ void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFi
   }
 }
 
-// E_ij = −μ0 S w W
-double near_field_energy(const MomentDesc& set, const Magnetization& mz,
-                         const NearFieldOptions& opt, NearFieldWorkspace* ws) {
+namespace {
+// Σ over the near pairs of term(geometry, state at mz)
+template <class Term>
+double sum_over_pairs(const MomentDesc& set, const Magnetization& mz, const NearFieldOptions& opt,
+                      NearFieldWorkspace* ws, Term term) {
   if (opt.model != NearField::Pair) return 0.0;
   const std::vector<PairStatic>& st = statics_of(set, ws);
   const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  double E = 0;
+  double sum = 0;
   for (std::size_t n = 0; n < st.size(); ++n) {
     const int i = ws->pairs[n].i, j = ws->pairs[n].j;
-    const PairState s = state_of(st[n], tab, moment(set, mz, i), moment(set, mz, j), inv_vms(set, i), inv_vms(set, j));
-    E -= kMu0 * st[n].S * st[n].w * s.W;
+    sum += term(st[n], state_of(st[n], tab, moment(set, mz, i), moment(set, mz, j), inv_vms(set, i), inv_vms(set, j)));
   }
-  return E;
+  return sum;
+}
+}  // namespace
+
+// E_ij = −μ0 S w W
+double near_field_energy(const MomentDesc& set, const Magnetization& mz,
+                         const NearFieldOptions& opt, NearFieldWorkspace* ws) {
+  return sum_over_pairs(set, mz, opt, ws,
+                        [](const PairStatic& q, const PairState& s) { return -kMu0 * q.S * q.w * s.W; });
 }
 
 // ½ μ0 (m_i·H_i + m_j·H_j) of pair_field is −E_ij + ½ μ0 S w W_h (dh/dζ̄) ζ̄, so the excess
 // E_ij + ½ μ0 Σ m·H_near is ½ μ0 S w W_h (dh/dζ̄) ζ̄ per pair
 double near_field_coenergy_excess(const MomentDesc& set, const Magnetization& mz,
                                   const NearFieldOptions& opt, NearFieldWorkspace* ws) {
-  if (opt.model != NearField::Pair) return 0.0;
-  const std::vector<PairStatic>& st = statics_of(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
-  double X = 0;
-  for (std::size_t n = 0; n < st.size(); ++n) {
-    const int i = ws->pairs[n].i, j = ws->pairs[n].j;
-    const PairState s = state_of(st[n], tab, moment(set, mz, i), moment(set, mz, j), inv_vms(set, i), inv_vms(set, j));
-    X += 0.5 * kMu0 * st[n].S * st[n].w * s.Wh * s.hz * s.zeta;
-  }
-  return X;
+  return sum_over_pairs(set, mz, opt, ws, [](const PairStatic& q, const PairState& s) {
+    return 0.5 * kMu0 * q.S * q.w * s.Wh * s.hz * s.zeta;
+  });
 }
 
 // E = −μ0 S(g) w W at fixed moments (so fixed ζ̄ and h): r = p_i − p_j, ρ = |r|,

@@ -1,5 +1,6 @@
 """tools/reference/near_field_common.py — what the near-field reference scripts share: the
-magsolve argument and its check, and the markdown table of a ratio per gap × field cell."""
+magsolve argument and its check, the markdown table of a ratio per gap × field cell, and the
+axial prototypes' central differences in the balls' positions."""
 import os
 import sys
 
@@ -30,3 +31,16 @@ def gap_field_table(gaps, fields, cell):
     lines = ["| g/a | " + " | ".join(f"{h:g}" for h in fields) + " |", "|---" * (len(fields) + 1) + "|"]
     lines += [f"| {g:g} | " + " | ".join(cell(g, h) for h in fields) + " |" for g in gaps]
     return lines
+
+
+
+def central_z(z, fn, step):
+    """[d fn / d z_k for every k] by central differences of `step` (m), z a numpy array: the
+    axial prototypes' forces at fixed moments (the envelope theorem)."""
+    out = []
+    for k in range(len(z)):
+        zp, zm = z.copy(), z.copy()
+        zp[k] += step
+        zm[k] -= step
+        out.append((fn(zp) - fn(zm)) / (2 * step))
+    return out

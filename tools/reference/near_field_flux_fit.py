@@ -14,8 +14,9 @@ The model, on the axis (every moment along z; M in Ms, moments m = V Ms M):
     h = zbar / (3 sqrt(1 - zbar^2)),   zbar = (M_i + M_j)/2,
 Psi' = atanh(M)/3 (the engine's curve tanh(3H/Ms)), nu the contact count of
 near_field_widen_trials.py (1 for a lone pair, 1.5 at a chain's end, 2 inside). M solves
-dU/dM = 0 (not M = f(H0 + K m): K depends on M), and the forces are -dU/dz at fixed M (the
-envelope theorem), both by central differences here. `--no-fit` evaluates the engine's
+dU/dM = 0 (not M = f(H0 + K m): K depends on M; solved for atanh M, the interaction's
+M-derivative by central differences), and the forces are -dU/dz at fixed M (the envelope
+theorem, by central differences). `--no-fit` evaluates the engine's
 constants only. Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
 evaluated beside it on the same chains."""
 import argparse
@@ -92,24 +93,28 @@ def chain(n, gap, h0, par, applied=False):
         warnings.simplefilter("ignore")
         M = fsolve(lambda M: M - np.tanh(3.0 * (h0 * MS + kmat(z, M, start, h0) @ (V * M * MS)) / MS),
                    np.full(n, min(0.9, 3 * h0)), xtol=1e-13)
-        if not applied:  # dU/dM = 0
-            def grad(M):
-                out = np.zeros(n)
+        if not applied:
+            # dU/dM_i/(V Ms^2) = atanh(M_i)/3 - h0 - d(1/2 m K m)/dM_i/(V Ms^2) = 0, solved for
+            # u = atanh(M) (well scaled up to saturation); the interaction's derivative by central
+            # differences in M
+            def residual(u):
+                M = np.tanh(u)
+                out = u / 3.0 - h0
                 for i in range(n):
-                    e = 1e-7 * max(M[i], 1e-6)
+                    e = 1e-7
                     Mp, Mm = M.copy(), M.copy()
                     Mp[i] += e
                     Mm[i] -= e
-                    out[i] = (energy(z, Mp, h0, par, False) - energy(z, Mm, h0, par, False)) / (2 * e)
-                return out / (V * MS * MS)
-            M = fsolve(grad, np.clip(M, 1e-12, 1 - 1e-9), xtol=1e-12)
-    F = np.zeros(n)
-    e = 1e-7 * A
-    for k in range(n):
-        zp, zm = z.copy(), z.copy()
-        zp[k] += e
-        zm[k] -= e
-        F[k] = -MU0 * (energy(zp, M, h0, par, applied) - energy(zm, M, h0, par, applied)) / (2 * e)
+                    mp, mm = V * MS * Mp, V * MS * Mm
+                    dE = 0.5 * (mp @ kmat(z, Mp, par) @ mp - mm @ kmat(z, Mm, par) @ mm) / (2 * e)
+                    out[i] -= dE / (V * MS * MS)
+                return out
+            u, _, ier, msg = fsolve(residual, np.arctanh(np.clip(M, 1e-12, 1 - 1e-12)), xtol=1e-13,
+                                    full_output=True)
+            if ier != 1 and np.max(np.abs(residual(u))) > 1e-9:
+                raise RuntimeError(f"no stationary magnetization for N {n}, g {gap}, H0 {h0}: {msg}")
+            M = np.tanh(u)
+    F = -MU0 * np.array(nfcommon.central_z(z, lambda zz: energy(zz, M, h0, par, applied), 1e-7 * A))
     return F, float(np.sum(V * MS * M))
 
 
@@ -122,18 +127,6 @@ def ratios(cells, keys, par, applied=False):
         out[key] = {"end": F[top] / c["F"][top], "moment": mom / c["moment"],
                     "mid": F[top - 1] / c["F"][top - 1] if (top - 1) in c["F"] else None}
     return out
-
-
-def print_chains(name, r, chains):
-    print(f"\n{name}: chains / FEM, H0/Ms " + ", ".join(f"{h:g}" for h in sorted({c[2] for c in chains})))
-    for n, g in sorted({(c[0], c[1]) for c in chains}, key=lambda k: (-k[1], k[0])):
-        sel = sorted(c for c in chains if c[0] == n and c[1] == g)
-        for q in ("end", "moment", "mid"):
-            if r[sel[0]][q] is None:
-                continue
-            vals = [r[c][q] for c in sel]
-            mark = "" if q == "mid" else f" ({sum(abs(v - 1) <= 0.25 for v in vals)}/{len(vals)} within 25 %)"
-            print(f"- N = {n}, g = {g:g}a, {q}: " + " ".join(f"{v:.2f}" for v in vals) + mark)
 
 
 def main(argv=None):
@@ -164,8 +157,8 @@ def main(argv=None):
               f"(3- and 4-chains at 0.003a); the engine has {ENGINE}")
     name = f"flux (kappa {par[0]:.4g}, q {par[1]:.4g}, beta {par[2]:.1f})"
     wt.print_pairs(name, ratios(cells, pairs, par), gaps, fields, train)
-    print_chains(name + "; training: N = 3, 4 at 0.003a", ratios(cells, chains, par), chains)
-    print_chains("candidate C (h = H0/Ms)", ratios(cells, chains, CANDIDATE_C, applied=True), chains)
+    wt.print_chains(name + "; training: N = 3, 4 at 0.003a", ratios(cells, chains, par), chains)
+    wt.print_chains("candidate C (h = H0/Ms)", ratios(cells, chains, CANDIDATE_C, applied=True), chains)
     return 0
 
 

@@ -77,13 +77,7 @@ def chain(n, gap, h, par, count):
     M = fsolve(lambda M: M - np.tanh(3.0 * (h * MS + K @ (V * M * MS)) / MS), np.full(n, min(1.0, 3 * h)),
                xtol=1e-13)
     m = V * M * MS
-    F = np.zeros(n)
-    e = 1e-7 * A
-    for k in range(n):
-        zp, zm = z.copy(), z.copy()
-        zp[k] += e
-        zm[k] -= e
-        F[k] = 0.5 * MU0 * m @ ((kmat(zp, h, par, count) - kmat(zm, h, par, count)) / (2 * e)) @ m
+    F = 0.5 * MU0 * np.array(nfcommon.central_z(z, lambda zz: m @ kmat(zz, h, par, count) @ m, 1e-7 * A))
     return F, float(np.sum(m))
 
 
@@ -114,15 +108,16 @@ def print_pairs(name, r, gaps, fields, train):
 
 
 def print_chains(name, r, chains):
-    print(f"\n{name}: chains (g = 0.003a) / FEM, H0/Ms " + ", ".join(f"{h:g}" for h in sorted({c[2] for c in chains})))
-    for n in sorted({c[0] for c in chains}):
-        sel = [c for c in chains if c[0] == n]
+    """One line per chain (N, gap) and figure: ratios over the fields, and the 25 % count."""
+    print(f"\n{name}: chains / FEM, H0/Ms " + ", ".join(f"{h:g}" for h in sorted({c[2] for c in chains})))
+    for n, g in sorted({(c[0], c[1]) for c in chains}, key=lambda k: (-k[1], k[0])):
+        sel = sorted(c for c in chains if c[0] == n and c[1] == g)
         for q in ("end", "moment", "mid"):
             if r[sel[0]][q] is None:
                 continue
             vals = [r[c][q] for c in sel]
             mark = "" if q == "mid" else f" ({sum(abs(v - 1) <= 0.25 for v in vals)}/{len(vals)} within 25 %)"
-            print(f"- N = {n}, {q}: " + " ".join(f"{v:.2f}" for v in vals) + mark)
+            print(f"- N = {n}, g = {g:g}a, {q}: " + " ".join(f"{v:.2f}" for v in vals) + mark)
 
 
 def main(argv=None):
