@@ -9,6 +9,7 @@
 #include "engine/limits.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -54,6 +55,25 @@ std::string value_text(const OptionValue& v, OptionKind kind) {
     }
   }
   return {};
+}
+
+OptionValue OptionSpec::parse(const std::string& text) const {
+  switch (kind) {
+    case OptionKind::Number:
+    case OptionKind::Integer: {
+      char* end = nullptr;
+      const double x = std::strtod(text.c_str(), &end);
+      if (text.empty() || *end != '\0') throw std::invalid_argument("expected a number, got '" + text + "'");
+      return x;
+    }
+    case OptionKind::Bool:
+      if (text == "on" || text == "true") return true;
+      if (text == "off" || text == "false") return false;
+      throw std::invalid_argument("expected on or off, got '" + text + "'");
+    case OptionKind::Name: return text;
+    case OptionKind::Vector: break;
+  }
+  throw std::invalid_argument("a vector has no one-word form");
 }
 
 std::string OptionSpec::error(const OptionValue& v) const {

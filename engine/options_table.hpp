@@ -104,6 +104,11 @@ struct OptionSpec {
   /// "" when v is a value of this option (its kind, range, names), else why not, in the scene
   /// file's wording: "must be in (0, 1] (got 1.5)", "unknown method 'x' (ours, ...)".
   std::string error(const OptionValue& v) const;
+  /// The value that `text` spells, as a command line gives it: a number, on/off (or true/false)
+  /// for a Bool, the name itself for a Name (error() then checks it). Throws
+  /// std::invalid_argument with the reason ("expected a number, got 'x'") for anything else,
+  /// and for a Vector (no one-word form).
+  OptionValue parse(const std::string& text) const;
   /// Its default, declared in the table; equal to its value in a default-constructed SimOptions.
   const OptionValue& default_value() const { return def; }
   /// The values it takes, for SCENE_FILE.md and --help: "a number in (0, 0.1]", "true or

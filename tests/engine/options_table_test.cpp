@@ -235,3 +235,32 @@ TEST_CASE("options table: scenes/SCENE_FILE.md lists every option, its default a
   CHECK(listed.size() == n);  // no option the table lacks
   CHECK(old_keys.size() == n_old);
 }
+
+TEST_CASE("options table: parse reads a command line's word for every kind, and names what it is not", "[options_table]") {
+  // the one text-to-value reading that magsim-scene's flags and bench_rest's --variant share
+  for (const OptionSpec& s : engine::options_table()) {
+    INFO(s.key);
+    switch (s.kind) {
+      case OptionKind::Number:
+      case OptionKind::Integer:
+        CHECK(std::get<double>(s.parse("0.25")) == 0.25);
+        CHECK(std::get<double>(s.parse("1e-3")) == 1e-3);
+        CHECK_THROWS_WITH(s.parse("abc"), "expected a number, got 'abc'");
+        CHECK_THROWS_WITH(s.parse("2x"), "expected a number, got '2x'");
+        CHECK_THROWS_WITH(s.parse(""), "expected a number, got ''");
+        break;
+      case OptionKind::Bool:
+        CHECK(std::get<bool>(s.parse("on")));
+        CHECK(std::get<bool>(s.parse("true")));
+        CHECK_FALSE(std::get<bool>(s.parse("off")));
+        CHECK_FALSE(std::get<bool>(s.parse("false")));
+        CHECK_THROWS_WITH(s.parse("maybe"), "expected on or off, got 'maybe'");
+        break;
+      case OptionKind::Name:
+        CHECK(std::get<std::string>(s.parse(s.names.front())) == s.names.front());
+        CHECK_FALSE(s.error(s.parse("no-such-name")).empty());  // error() refuses it
+        break;
+      case OptionKind::Vector: CHECK_THROWS_AS(s.parse("1"), std::invalid_argument); break;
+    }
+  }
+}

@@ -52,32 +52,17 @@ Variant parse_variant(const std::string& text, const char* flag = "--variant") {
   return v;
 }
 
-eng::OptionValue value_of(const eng::OptionSpec& spec, const std::string& text) {
-  switch (spec.kind) {
-    case eng::OptionKind::Bool:
-      if (text == "true" || text == "on") return true;
-      if (text == "false" || text == "off") return false;
-      throw std::invalid_argument(spec.key + ": expected true or false (got '" + text + "')");
-    case eng::OptionKind::Name:
-      return text;
-    case eng::OptionKind::Vector:
-      throw std::invalid_argument(spec.key + ": vectors cannot be varied here");
-    default: {
-      char* end = nullptr;
-      const double x = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0')
-        throw std::invalid_argument(spec.key + ": expected a number (got '" + text + "')");
-      return x;
-    }
-  }
-}
-
 void apply(const Variant& v, eng::SimOptions* o) {
   for (const auto& [key, text] : v.sets) {
     const auto& table = eng::options_table();
     const auto it = std::find_if(table.begin(), table.end(), [&](const eng::OptionSpec& s) { return s.key == key; });
     if (it == table.end()) throw std::invalid_argument("unknown option '" + key + "'");
-    const eng::OptionValue x = value_of(*it, text);
+    eng::OptionValue x;
+    try {
+      x = it->parse(text);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(key + ": " + e.what());
+    }
     const std::string err = it->error(x);
     if (!err.empty()) throw std::invalid_argument(key + " " + err);
     it->set(*o, x);

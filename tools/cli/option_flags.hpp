@@ -84,27 +84,26 @@ class OptionFlags {
     return f ? f->text : none;
   }
 
-  /// Sets each option whose flag was given. Throws std::invalid_argument "<flag>: <why>" for a
-  /// bool that is neither on nor off and a name its table lacks (the numbers were checked by
-  /// their validators).
+  /// Sets each option whose flag was given (OptionSpec::parse, then error()). Throws
+  /// std::invalid_argument "<flag>: <why>" for a bool that is neither on nor off and a name
+  /// its table lacks (the numbers were checked by their validators already).
   void apply(engine::SimOptions* o) const {
     for (const Flag& f : flags_) {
       if (f.option->count() == 0) continue;
       const engine::OptionSpec& s = *f.spec;
-      switch (s.kind) {
-        case engine::OptionKind::Number:
-        case engine::OptionKind::Integer: s.set(*o, std::strtod(f.text.c_str(), nullptr)); break;
-        case engine::OptionKind::Bool:
-          if (s.flag_switch) s.set(*o, true);
-          else if (f.text == "on" || f.text == "off") s.set(*o, f.text == "on");
-          else throw std::invalid_argument(s.flag + ": expected on or off, got '" + f.text + "'");
-          break;
-        case engine::OptionKind::Name:
-          if (const std::string e = s.error(f.text); !e.empty()) throw std::invalid_argument(s.flag + ": " + e);
-          s.set(*o, f.text);
-          break;
-        case engine::OptionKind::Vector: throw std::logic_error(s.flag + ": no flag for a vector option");
+      if (s.kind == engine::OptionKind::Vector) throw std::logic_error(s.flag + ": no flag for a vector option");
+      if (s.kind == engine::OptionKind::Bool && s.flag_switch) {
+        s.set(*o, true);
+        continue;
       }
+      engine::OptionValue v;
+      try {
+        v = s.parse(f.text);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(s.flag + ": " + e.what());
+      }
+      if (const std::string e = s.error(v); !e.empty()) throw std::invalid_argument(s.flag + ": " + e);
+      s.set(*o, v);
     }
   }
   /// apply() to the magnetics alone (magsolve's options are a mag::DynamicsOptions).
