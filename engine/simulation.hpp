@@ -114,8 +114,8 @@ class Simulation {
   /// the converged magnetization) and the forces into ws_ (not applied).
   void solve_magnetics(mag::Magnetization* mz, bool solve, long n);
   /// U* (or zeeman-total's E_sys) of the magnetization mz from the field of the last force
-  /// evaluation (J).
-  double coenergy(const mag::Magnetization& mz) const;
+  /// evaluation (J). Not const: the pair model reads its pairs from the field's workspace.
+  double coenergy(const mag::Magnetization& mz);
   void rollback();
   void check_body_index(int i) const;
 

@@ -52,17 +52,16 @@ class OmpThreadScope {
 
 }  // namespace
 
-double Simulation::coenergy(const mag::Magnetization& mz) const {
+double Simulation::coenergy(const mag::Magnetization& mz) {
   const Model& m = *model_;
   if (ws_.mag.H.size() != moments_.size()) return 0.0;
   // the potential of the force where it has its own (zeeman-total: E_sys, forces_total.hpp)
   if (m.resolved.force == mag::ForceModel::ZeemanTotal)
     return mag::zeeman_total_energy(moments_, mz, m.resolved.curve, ws_.mag.H,
                                     ws_.mag.total.perm, ws_.mag.total.Hp);
-  if (m.options.magnetics.field.near_field.model == mag::NearField::Dipole)
-    return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H);
-  mag::NearFieldWorkspace nws;  // the pair list of these positions (const: not the step's cache)
-  return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H, m.options.magnetics.field.near_field, &nws);
+  // the pair model's pairs and geometry: the field evaluation's cache, of these same poses
+  return mag::magnetic_coenergy(moments_, mz, m.resolved.curve, ws_.mag.H, m.options.magnetics.field.near_field,
+                                &ws_.mag.field.near);
 }
 
 void Simulation::solve_magnetics(mag::Magnetization* mz, bool solve, long n) {

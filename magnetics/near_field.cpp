@@ -99,14 +99,22 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
   perp2_ = spline_second(perp_, table_step());
 }
 
+namespace {
+// The saturated layer's width κ h^q (radii) and its h-derivative κ q h^{q−1}
+double widening(double h, double* dw_dh) {
+  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  *dw_dh = h > 0 ? kPairWidenPower * w / h : 0.0;
+  return w;
+}
+}  // namespace
+
 // G = g_e(g) + κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = κ q h^{q−1}
 double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh) {
-  double dge = 0;
-  const double ge = pair_effective_gap(g, &dge);
-  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
+  double dge = 0, dw = 0;
+  const double G = pair_effective_gap(g, &dge) + widening(h, &dw);
   if (dG_dg) *dG_dg = dge;
-  if (dG_dh) *dG_dh = h > 0 ? kPairWidenPower * w / h : 0.0;
-  return ge + w;
+  if (dG_dh) *dG_dh = dw;
+  return G;
 }
 
 // h = ζ/(3 √(1 − ζ²)), dh/dζ = (1 − ζ²)^{−3/2}/3
@@ -127,8 +135,8 @@ PairCoupling PairCouplingTable::at(double g, double h) const {
 
 // G = g_e + κ h^q as pair_widened_gap, from g_e and dg_e/dg
 PairCoupling PairCouplingTable::at_effective(double ge, double dge_dg, double h) const {
-  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
-  const double G = ge + w, dGh = h > 0 ? kPairWidenPower * w / h : 0.0;
+  double dGh = 0;
+  const double G = ge + widening(h, &dGh);
   const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
@@ -237,7 +245,6 @@ void find_near_pairs(const MomentDesc& set, NearFieldWorkspace* ws) {
   }
 }
 
-
 namespace {
 bool same_description(const MomentDesc& a, const MomentDesc& b) {
   return a.position == b.position && a.volume == b.volume && a.radius == b.radius &&
@@ -281,16 +288,13 @@ struct PairState {
   double A = 0, B = 0, dA = 0, dB = 0;  // and their ρ-derivatives
   double W = 0, Wh = 0;                 // W and ∂W/∂h
   double hz = 0, zeta = 0;              // dh/dζ̄, ζ̄
-  double zi = 0, zj = 0;                // ζ_i, ζ_j
 };
 
 PairState state_of(const PairStatic& q, const PairCouplingTable& tab, const Vec3& mi, const Vec3& mj,
                    double ci, double cj) {
   // ci, cj = 1/(V Ms) of each ball
   PairState s;
-  s.zi = mi.norm() * ci;
-  s.zj = mj.norm() * cj;
-  s.zeta = 0.5 * (s.zi + s.zj);
+  s.zeta = 0.5 * (mi.norm() * ci + mj.norm() * cj);
   const double h = pair_flux_field(s.zeta, &s.hz);
   const PairCoupling c = tab.at_effective(q.ge, q.dge, h);
   const double a3 = q.a * q.a * q.a;
