@@ -76,6 +76,18 @@ OptionValue OptionSpec::parse(const std::string& text) const {
   throw std::invalid_argument("a vector has no one-word form");
 }
 
+std::string OptionSpec::assign(SimOptions& o, const std::string& text) const {
+  OptionValue v;
+  try {
+    v = parse(text);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  if (std::string e = error(v); !e.empty()) return e;
+  set(o, v);
+  return {};
+}
+
 std::string OptionSpec::error(const OptionValue& v) const {
   switch (kind) {
     case OptionKind::Number:

@@ -109,6 +109,9 @@ struct OptionSpec {
   /// std::invalid_argument with the reason ("expected a number, got 'x'") for anything else,
   /// and for a Vector (no one-word form).
   OptionValue parse(const std::string& text) const;
+  /// parse(text), error() and set() in one: "" when `o` now holds the value, else why not
+  /// (nothing set), for the caller to prefix with its flag or key.
+  std::string assign(SimOptions& o, const std::string& text) const;
   /// Its default, declared in the table; equal to its value in a default-constructed SimOptions.
   const OptionValue& default_value() const { return def; }
   /// The values it takes, for SCENE_FILE.md and --help: "a number in (0, 0.1]", "true or

@@ -57,15 +57,7 @@ void apply(const Variant& v, eng::SimOptions* o) {
     const auto& table = eng::options_table();
     const auto it = std::find_if(table.begin(), table.end(), [&](const eng::OptionSpec& s) { return s.key == key; });
     if (it == table.end()) throw std::invalid_argument("unknown option '" + key + "'");
-    eng::OptionValue x;
-    try {
-      x = it->parse(text);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(key + ": " + e.what());
-    }
-    const std::string err = it->error(x);
-    if (!err.empty()) throw std::invalid_argument(key + " " + err);
-    it->set(*o, x);
+    if (const std::string err = it->assign(*o, text); !err.empty()) throw std::invalid_argument(key + ": " + err);
   }
 }
 

@@ -84,7 +84,7 @@ class OptionFlags {
     return f ? f->text : none;
   }
 
-  /// Sets each option whose flag was given (OptionSpec::parse, then error()). Throws
+  /// Sets each option whose flag was given (OptionSpec::assign). Throws
   /// std::invalid_argument "<flag>: <why>" for a bool that is neither on nor off and a name
   /// its table lacks (the numbers were checked by their validators already).
   void apply(engine::SimOptions* o) const {
@@ -96,14 +96,7 @@ class OptionFlags {
         s.set(*o, true);
         continue;
       }
-      engine::OptionValue v;
-      try {
-        v = s.parse(f.text);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(s.flag + ": " + e.what());
-      }
-      if (const std::string e = s.error(v); !e.empty()) throw std::invalid_argument(s.flag + ": " + e);
-      s.set(*o, v);
+      if (const std::string e = s.assign(*o, f.text); !e.empty()) throw std::invalid_argument(s.flag + ": " + e);
     }
   }
   /// apply() to the magnetics alone (magsolve's options are a mag::DynamicsOptions).
