@@ -6,7 +6,7 @@ the 3- and 4-chains, and the check on the rest (pair check half, 5- and 7-chains
 g = 0.003a, 3- and 5-chains at 0.01a and 0.03a).
 
     /usr/bin/python3 tools/reference/near_field_flux_fit.py [--fem tools/reference/data/near_field_fem.csv]
-        [--chains tools/reference/data/near_field_fem_chains.csv] [--no-fit]
+        [--chains tools/reference/data/near_field_fem_chains.csv] [--no-fit] [--curve tanh|sphere]
 
 The model, on the axis (every moment along z; M in Ms, moments m = V Ms M):
     U(M; z)/mu0 = sum V Ms^2 Psi(M_i) - sum m_i H0 - sum_{i<j} m_i m_j K_ij(z, M),
@@ -17,7 +17,9 @@ near_field_widen_trials.py (1 for a lone pair, 1.5 at a chain's end, 2 inside). 
 dU/dM = 0 (not M = f(H0 + K m): K depends on M; solved for atanh M, the interaction's
 M-derivative by central differences), and the forces are -dU/dz at fixed M (the envelope
 theorem, by central differences). `--no-fit` evaluates the engine's
-constants only. Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
+constants only. `--curve sphere` swaps the engine's curve for the law of a sphere of the
+reference's own bulk iron, M = Ms tanh(999 (H - M/3)/Ms) (Psi' = atanh(M)/999 + M/3); its U
+is not convex in M near Ms, so M is the least-U stationary point from four starts. Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
 evaluated beside it on the same chains."""
 import argparse
 import math
@@ -26,7 +28,7 @@ import sys
 import warnings
 
 import numpy as np
-from scipy.optimize import fsolve, minimize
+from scipy.optimize import brentq, fsolve, minimize
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -40,6 +42,21 @@ CANDIDATE_C = (0.553, 1.22, 0.4, 1.0)  # kappa, q, beta, gamma with h = H0/Ms
 G_TAIL = 2.2
 DT_TAIL = float(nf.SPLINE(math.log(G_TAIL)))
 LAMBDA = float(nf.SPLINE(math.log(G_TAIL), 1)) / DT_TAIL
+CHI = 999.0  # the reference's iron: mu_r,initial 1000
+CURVE = "tanh"  # the balls' curve: tanh = the engine's eq. 10; sphere = the reference's iron
+
+
+def psi(M):
+    """The curve's stored energy over Ms^2 (the integral of f^-1(M)/Ms): eq. 10's tanh(3H/Ms),
+    or a sphere of the reference's bulk iron, M = Ms tanh(chi (H - M/3)/Ms), whose
+    f^-1(M)/Ms = atanh(M)/chi + M/3."""
+    lg = M * np.arctanh(M) + 0.5 * np.log1p(-M * M)
+    return lg / 3.0 if CURVE == "tanh" else lg / CHI + M * M / 6.0
+
+
+def psi_prime_of_u(u):
+    """f^-1(M)/Ms at M = tanh u."""
+    return u / 3.0 if CURVE == "tanh" else u / CHI + np.tanh(u) / 3.0
 
 
 def dt_of(G):
@@ -77,12 +94,11 @@ def kmat(z, M, par, h0=None):
     return K
 
 
-def energy(z, M, h0, par, applied):
-    """U/mu0 (A^2 m)."""
+def energy(z, M, h0, par, applied, stored=True):
+    """U/mu0 (A^2 m); without the curve's stored energy (constant in z at fixed M) if not stored."""
     m = V * MS * M
     K = kmat(z, M, par, h0 if applied else None)
-    psi = (M * np.arctanh(M) + 0.5 * np.log1p(-M * M)) / 3.0
-    return V * MS * MS * np.sum(psi) - np.sum(m) * h0 * MS - 0.5 * m @ K @ m
+    return (V * MS * MS * np.sum(psi(M)) if stored else 0.0) - np.sum(m) * h0 * MS - 0.5 * m @ K @ m
 
 
 def chain(n, gap, h0, par, applied=False):
@@ -99,7 +115,7 @@ def chain(n, gap, h0, par, applied=False):
             # differences in M
             def residual(u):
                 M = np.tanh(u)
-                out = u / 3.0 - h0
+                out = psi_prime_of_u(u) - h0
                 for i in range(n):
                     e = 1e-7
                     Mp, Mm = M.copy(), M.copy()
@@ -109,12 +125,22 @@ def chain(n, gap, h0, par, applied=False):
                     dE = 0.5 * (mp @ kmat(z, Mp, par) @ mp - mm @ kmat(z, Mm, par) @ mm) / (2 * e)
                     out[i] -= dE / (V * MS * MS)
                 return out
-            u, _, ier, msg = fsolve(residual, np.arctanh(np.clip(M, 1e-12, 1 - 1e-12)), xtol=1e-13,
-                                    full_output=True)
-            if ier != 1 and np.max(np.abs(residual(u))) > 1e-9:
+            starts = [np.arctanh(np.clip(M, 1e-12, 1 - 1e-12))]
+            if CURVE == "sphere":
+                # U is not convex in M on the sphere curve near Ms (its f^-1 is stiff only as
+                # 1/chi in u): start from lone spheres at H0 and at a few raised fields, and keep
+                # the stationary point of least U
+                starts = [np.full(n, brentq(lambda w: psi_prime_of_u(w) - hh, 0.0, CHI * (hh + 1.0)))
+                          for hh in (h0, 1.1 * h0, 1.3 * h0, 2.0 * h0)]
+            found = []
+            for u0 in starts:
+                u, _, ier, msg = fsolve(residual, u0, xtol=1e-13, full_output=True)
+                if ier == 1 or np.max(np.abs(residual(u))) <= 1e-9:
+                    found.append((energy(z, np.tanh(u), h0, par, False), tuple(u)))
+            if not found:
                 raise RuntimeError(f"no stationary magnetization for N {n}, g {gap}, H0 {h0}: {msg}")
-            M = np.tanh(u)
-    F = -MU0 * np.array(nfcommon.central_z(z, lambda zz: energy(zz, M, h0, par, applied), 1e-7 * A))
+            M = np.tanh(np.array(min(found)[1]))
+    F = -MU0 * np.array(nfcommon.central_z(z, lambda zz: energy(zz, M, h0, par, applied, False), 1e-7 * A))
     return F, float(np.sum(V * MS * M))
 
 
@@ -134,7 +160,11 @@ def main(argv=None):
     ap.add_argument("--fem", default=os.path.join(HERE, "data", "near_field_fem.csv"))
     ap.add_argument("--chains", default=os.path.join(HERE, "data", "near_field_fem_chains.csv"))
     ap.add_argument("--no-fit", action="store_true", help="the engine's constants only")
+    ap.add_argument("--curve", choices=("tanh", "sphere"), default="tanh",
+                    help="the balls' curve: tanh (the engine's eq. 10) or sphere (the reference's bulk iron)")
     args = ap.parse_args(argv)
+    global CURVE
+    CURVE = args.curve
     cells = nf.load_fem(args.fem)
     cells.update(nf.load_fem(args.chains))
     pairs = sorted(k for k in cells if k[0] == 2)
