@@ -23,7 +23,7 @@ void picard_image(const MomentDesc& set, const Magnetization& mz, const Dynamics
                   MagWorkspace* ws) {
   compute_fields(set, mz, opt.field, &ws->H, nullptr, &ws->field);
   AndersonHistory& h = ws->anderson;
-  const Curve curve = curve_of(Method::Anderson);
+  const Curve curve = curve_of(Method::Anderson, opt.field.near_field.curve);
   const long k = static_cast<long>(h.idx.size());
 #pragma omp parallel for schedule(static)
   for (long a = 0; a < k; ++a) {
@@ -101,7 +101,7 @@ void store(const AndersonHistory& h, const MomentDesc& set, Magnetization* mz) {
 double picard_iteration(const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt,
                         MagWorkspace* ws) {
   compute_fields(set, *mz, opt.field, &ws->H, nullptr, &ws->field);
-  const Curve curve = curve_of(Method::Anderson);
+  const Curve curve = curve_of(Method::Anderson, opt.field.near_field.curve);
   const long n = static_cast<long>(set.size());
   double max_change = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change)
@@ -109,7 +109,7 @@ double picard_iteration(const MomentDesc& set, Magnetization* mz, const Dynamics
     if (!set.solved(j)) continue;
     const double Ms = set.Ms[j];
     const Vec3 M_old = mz->M[j];
-    mz->set_magnetization(j, curve_M(curve, ws->H[j], Ms), Ms);  // eq. 10
+    mz->set_magnetization(j, curve_M(curve, ws->H[j], Ms), Ms);  // M = f(H)
     max_change = std::max(max_change, (mz->M[j] - M_old).norm() / Ms);
   }
   return max_change;

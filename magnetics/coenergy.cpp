@@ -10,6 +10,10 @@ namespace magsim::mag {
 double curve_energy_density(Curve c, double Mnorm, double Ms) {
   const double x = std::min(Mnorm / Ms, 1.0);
   if (c == Curve::Kim) return Ms * Ms * x * x / 6.0;  // eq. 7: Ψ = |M|²/6
+  if (c == Curve::Iron) {
+    // f⁻¹ = Ms(atanh(x)/χ + x/3): Ψ = Ms²[x atanh x + ½ ln(1 − x²)]/χ + Ms² x²/6 = (3/χ) Ψ_tanh + Ms² x²/6
+    return 3.0 / kIronChi * curve_energy_density(Curve::Tanh, Mnorm, Ms) + Ms * Ms * x * x / 6.0;
+  }
   // eq. 10: Ψ = (Ms²/6)[(1 + x) ln(1 + x) + (1 − x) ln(1 − x)]; the series below x = 1e-3
   // (Ψ = (Ms²/6)(x² + x⁴/6 + x⁶/15 + …)) keeps the relative error at 1e-16 where log1p cancels
   if (x < 1e-3) {

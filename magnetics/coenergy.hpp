@@ -20,6 +20,7 @@ namespace magsim::mag {
 /// Ψ(|M|) = ∫₀^|M| |f⁻¹(s)| ds (J/m³ divided by μ0: A²/m²), the curve's stored energy density.
 ///   tanh (eq. 10): Ψ = (Ms²/3)[x atanh x + ½ ln(1 − x²)]
 ///                    = (Ms²/6)[(1 + x) ln(1 + x) + (1 − x) ln(1 − x)],  x = |M|/Ms ≤ 1;
+///   iron:          Ψ = (Ms²/χ)[x atanh x + ½ ln(1 − x²)] + |M|²/6
 ///   eq. 7:         Ψ = |M|²/6 (M = 3H below saturation; |M| ≤ Ms is a constraint).
 /// |M| above Ms (never produced by the methods) is taken as Ms.
 double curve_energy_density(Curve c, double Mnorm, double Ms);

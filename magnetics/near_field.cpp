@@ -71,6 +71,8 @@ std::string validate(const NearFieldOptions& o) {
   if (!(o.mu_r >= kMuMin && o.mu_r <= kMuMax))
     e << "near-field mu_r must be in [" << kMuMin << ", " << kMuMax << "] (the table's span), got "
       << o.mu_r;
+  else if (o.curve != Curve::Tanh && o.curve != Curve::Iron)
+    e << "curve must be tanh or iron, got " << kCurveNames.name(o.curve);
   return e.str();
 }
 
@@ -82,7 +84,8 @@ double pair_effective_gap(double g, double* dge_dg) {
   return kPairContactGap + kPairSmoothGap * sp;
 }
 
-PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
+PairCouplingTable::PairCouplingTable(double mu_r, Curve curve)
+    : mu_r_(mu_r), curve_(curve), widen_(pair_widening(curve)) {
   // row r and weight w of μr between the tabulated ones, linear in ln μr
   int r = 0;
   while (r < kTableMuCount - 2 && mu_r > kTableMu[r + 1]) ++r;
@@ -99,19 +102,24 @@ PairCouplingTable::PairCouplingTable(double mu_r) : mu_r_(mu_r) {
   perp2_ = spline_second(perp_, table_step());
 }
 
+PairWidening pair_widening(Curve c) {
+  if (c == Curve::Iron) return {kPairWidenScaleIron, kPairWidenPowerIron};
+  return {kPairWidenScale, kPairWidenPower};
+}
+
 namespace {
 // The saturated layer's width κ h^q (radii) and its h-derivative κ q h^{q−1}
-double widening(double h, double* dw_dh) {
-  const double w = h > 0 ? kPairWidenScale * dmath::pow(h, kPairWidenPower) : 0.0;
-  *dw_dh = h > 0 ? kPairWidenPower * w / h : 0.0;
+double widening(const PairWidening& k, double h, double* dw_dh) {
+  const double w = h > 0 ? k.scale * dmath::pow(h, k.power) : 0.0;
+  *dw_dh = h > 0 ? k.power * w / h : 0.0;
   return w;
 }
 }  // namespace
 
 // G = g_e(g) + κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = κ q h^{q−1}
-double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh) {
+double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh, Curve c) {
   double dge = 0, dw = 0;
-  const double G = pair_effective_gap(g, &dge) + widening(h, &dw);
+  const double G = pair_effective_gap(g, &dge) + widening(pair_widening(c), h, &dw);
   if (dG_dg) *dG_dg = dge;
   if (dG_dh) *dG_dh = dw;
   return G;
@@ -136,7 +144,7 @@ PairCoupling PairCouplingTable::at(double g, double h) const {
 // G = g_e + κ h^q as pair_widened_gap, from g_e and dg_e/dg
 PairCoupling PairCouplingTable::at_effective(double ge, double dge_dg, double h) const {
   double dGh = 0;
-  const double G = ge + widening(h, &dGh);
+  const double G = ge + widening(widen_, h, &dGh);
   const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
@@ -173,10 +181,10 @@ double pair_count_switch(double g, double* dS_dg) {
   return quintic_step(g, kPairCountFullGap, kPairCountCutoffGap, dS_dg);
 }
 
-const PairCouplingTable& NearFieldWorkspace::table_for(double mu_r) {
-  if (table.empty() || table[0].mu_r() != mu_r) {
+const PairCouplingTable& NearFieldWorkspace::table_for(const NearFieldOptions& opt) {
+  if (table.empty() || table[0].mu_r() != opt.mu_r || table[0].curve() != opt.curve) {
     table.clear();
-    table.emplace_back(mu_r);
+    table.emplace_back(opt.mu_r, opt.curve);
   }
   return table[0];
 }
@@ -328,7 +336,7 @@ void near_field_jacobian(const MomentDesc& set, const Magnetization& mz, const N
   out->clear();
   if (opt.model != NearField::Pair) return;
   const std::vector<PairStatic>& st = statics_of(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  const PairCouplingTable& tab = ws->table_for(opt);
   for (std::size_t n = 0; n < st.size(); ++n) {
     const int i = ws->pairs[n].i, j = ws->pairs[n].j;
     const int ids[2] = {i, j};
@@ -354,7 +362,7 @@ void add_near_field(const MomentDesc& set, const Magnetization& mz, const NearFi
                     NearFieldWorkspace* ws, std::vector<Vec3>* H) {
   if (opt.model != NearField::Pair) return;
   const std::vector<PairStatic>& st = statics_of(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  const PairCouplingTable& tab = ws->table_for(opt);
   for (std::size_t n = 0; n < st.size(); ++n) {
     const int i = ws->pairs[n].i, j = ws->pairs[n].j;
     Vec3 Hi, Hj;
@@ -371,7 +379,7 @@ double sum_over_pairs(const MomentDesc& set, const Magnetization& mz, const Near
                       NearFieldWorkspace* ws, Term term) {
   if (opt.model != NearField::Pair) return 0.0;
   const std::vector<PairStatic>& st = statics_of(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  const PairCouplingTable& tab = ws->table_for(opt);
   double sum = 0;
   for (std::size_t n = 0; n < st.size(); ++n) {
     const int i = ws->pairs[n].i, j = ws->pairs[n].j;
@@ -409,7 +417,7 @@ void add_near_field_forces(const MomentDesc& set, const Magnetization& mz,
                            std::vector<Vec3>* F, std::vector<Vec3>* /*tau*/) {
   if (opt.model != NearField::Pair) return;
   const std::vector<PairStatic>& st = statics_of(set, ws);
-  const PairCouplingTable& tab = ws->table_for(opt.mu_r);
+  const PairCouplingTable& tab = ws->table_for(opt);
   std::vector<double> Lam(st.size(), 0.0), lam(set.size(), 0.0);
   for (std::size_t n = 0; n < st.size(); ++n) {
     const PairStatic& q = st[n];

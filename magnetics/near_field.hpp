@@ -26,7 +26,8 @@
 //     Ms that magnetizes a lone ball to ζ̄ to first order (ζ ≈ 3h), growing without bound as
 //     the iron saturates. A contact in a chain, whose balls carry the chain's flux, thus
 //     saturates at a lower applied field than a lone pair. κ and q are fitted to the
-//     nonlinear finite-element table (tools/findings/near_field_reference.md). At low field
+//     nonlinear finite-element table (tools/findings/near_field_reference.md), once per
+//     curve of the balls (pair_widening). At low field
 //     G = g_e and the pair is exact linear; dG/dg = dg_e/dg > 0 and Δt falls with the gap,
 //     so the correction always attracts;
 //   * ν: the contacts the pair shares its balls' flux with, ν = 1 + (n_i + n_j)/2 − S_c(g),
@@ -66,6 +67,10 @@ struct NearFieldOptions {
   /// in the hundreds to thousands (1000 here). Only the pair model reads it; the engine's
   /// own law M = f(H) (initial slope 3) is μr = ∞.
   double mu_r = 1000.0;
+  /// The balls' curve M = f(H) (kCurveOptionNames): tanh = eq. 10, iron = a sphere of bulk
+  /// iron (curves.hpp). The methods that take a curve (anderson, exact) read it here, and the
+  /// pair model's widening κ h^q is fitted per curve (pair_widening).
+  Curve curve = Curve::Tanh;
 };
 
 /// Empty when usable, else a one-line reason.
@@ -76,8 +81,10 @@ inline constexpr double kPairFullGap = 1.0;       ///< S = 1 up to this gap
 inline constexpr double kPairCutoffGap = 2.0;     ///< S = 0 from this gap on: pure dipoles
 inline constexpr double kPairContactGap = 1.5e-3; ///< g_m: what contact reads as, 7.5 µm at a = 5 mm
 inline constexpr double kPairSmoothGap = 5e-4;    ///< g_s: the width of the step to g_m
-inline constexpr double kPairWidenScale = 0.3425;  ///< κ (gap widening per h^q, radii)
+inline constexpr double kPairWidenScale = 0.3425;  ///< κ (gap widening per h^q, radii), eq. 10's balls
 inline constexpr double kPairWidenPower = 1.277;   ///< q (κ and q fitted to the FEM table)
+inline constexpr double kPairWidenScaleIron = 0.7399;  ///< κ of Curve::Iron's balls
+inline constexpr double kPairWidenPowerIron = 1.527;   ///< q of Curve::Iron's balls
 inline constexpr double kPairCountFullGap = 0.5;  ///< S_c = 1 up to this gap
 inline constexpr double kPairCountCutoffGap = 1.0; ///< S_c = 0 from this gap on
 inline constexpr double kPairShareCoupling = 0.4;  ///< β: the coupling ν^−β
@@ -85,9 +92,17 @@ inline constexpr double kPairShareCoupling = 0.4;  ///< β: the coupling ν^−�
 /// g_e of a gap g and dg_e/dg.
 double pair_effective_gap(double g, double* dge_dg = nullptr);
 
+/// κ and q of the widening κ h^q for balls of curve c. Fitted per curve on the same training
+/// half: a weaker curve magnetizes the balls less, and its fit had absorbed that.
+struct PairWidening {
+  double scale, power;
+};
+PairWidening pair_widening(Curve c);
+
 /// The widened gap G = g_e(g) + κ h^q (radii) of a gap g at the saturation field h ≥ 0
-/// (pair_flux_field), with dG/dg and dG/dh.
-double pair_widened_gap(double g, double h, double* dG_dg = nullptr, double* dG_dh = nullptr);
+/// (pair_flux_field), with dG/dg and dG/dh; κ, q of curve c.
+double pair_widened_gap(double g, double h, double* dG_dg = nullptr, double* dG_dh = nullptr,
+                        Curve c = Curve::Tanh);
 
 /// The saturation field h = ζ/(3 √(1 − ζ²)) (in Ms) of a pair's mean reduced magnetization
 /// ζ = |M|/Ms ∈ [0, 1], and dh/dζ = (1 − ζ²)^{−3/2}/3. ζ is held just below 1 (h ≈ 7e3 there,
@@ -106,14 +121,17 @@ struct PairCoupling {
 };
 class PairCouplingTable {
  public:
-  explicit PairCouplingTable(double mu_r);
+  explicit PairCouplingTable(double mu_r, Curve curve = Curve::Tanh);
   double mu_r() const { return mu_r_; }
+  Curve curve() const { return curve_; }
   PairCoupling at(double g, double h = 0.0) const;
   /// The same from g_e(g) and dg_e/dg (a pair's cached effective gap).
   PairCoupling at_effective(double ge, double dge_dg, double h) const;
 
  private:
   double mu_r_;
+  Curve curve_;
+  PairWidening widen_;
   std::vector<double> par_, perp_, par2_, perp2_;  // node values and spline second derivatives
 };
 
@@ -152,7 +170,7 @@ struct NearFieldWorkspace {
   std::vector<double> count;  ///< (n) contact count n_i of `pairs`
   std::vector<std::pair<long long, int>> cells;  ///< scratch: (grid cell, moment)
   std::vector<PairCouplingTable> table;          ///< 0 or 1 entry
-  const PairCouplingTable& table_for(double mu_r);
+  const PairCouplingTable& table_for(const NearFieldOptions& opt);
 };
 
 /// Lists the eligible pairs (i < j, in that order) of `set` closer than the cut-off (and

@@ -33,9 +33,18 @@ inline constexpr NameTable<Method, 6> kMethodNames{{{Method::Ours, "ours"},
 /// Magnetization curve M = f(H).
 enum class Curve : std::uint8_t {
   Tanh,  ///< ours, eq. 10: f(H) = Ms tanh(3|H|/Ms) H/|H|
-  Kim    ///< Kim 2018, eq. 7: M = H/γ_D below saturation, Ms H/|H| above (γ_D = 1/3)
+  Kim,   ///< Kim 2018, eq. 7: M = H/γ_D below saturation, Ms H/|H| above (γ_D = 1/3)
+  /// A sphere of bulk iron, μr,initial = 1000 (kIronChi): M solves M = Ms tanh(χ(|H| − |M|/3)/Ms)
+  /// along H, the bulk tanh law inside a sphere's self-field −M/3 (PHYSICS.md, "The curves").
+  /// The near-field reference's material: eq. 10 gives a lone sphere 0.80× its moment at 0.3 Ms.
+  Iron
 };
-inline constexpr NameTable<Curve, 2> kCurveNames{{{Curve::Tanh, "tanh"}, {Curve::Kim, "kim"}}};
+inline constexpr NameTable<Curve, 3> kCurveNames{
+    {{Curve::Tanh, "tanh"}, {Curve::Kim, "kim"}, {Curve::Iron, "iron"}}};
+/// The curves an option may choose (kim is kim2018's own and comes with that method).
+inline constexpr NameTable<Curve, 2> kCurveOptionNames{{{Curve::Tanh, "tanh"}, {Curve::Iron, "iron"}}};
+/// χ = μr,initial − 1 of Curve::Iron.
+inline constexpr double kIronChi = 999.0;
 
 /// Force model for induced moments.
 enum class ForceModel : std::uint8_t {
@@ -59,6 +68,11 @@ inline constexpr NameTable<ForceModel, 4> kForceModelNames{{{ForceModel::Method,
 
 /// The curve a method converges to (Kim 2018 uses eq. 7, every other method eq. 10).
 inline Curve curve_of(Method m) { return m == Method::Kim2018 ? Curve::Kim : Curve::Tanh; }
+/// The curve a method converges to when `chosen` is asked for: Kim 2018 keeps eq. 7; anderson
+/// and exact take `chosen`; the θ dynamics keep eq. 10 (their γ_C is eq. 10's).
+inline Curve curve_of(Method m, Curve chosen) {
+  return m == Method::Anderson || m == Method::Exact ? chosen : curve_of(m);
+}
 /// The force model a method is paired with: eq. 4 for the paper's θ dynamics and the
 /// damping-only LLG (ours, ours-realigned, damping-llg: the paper's pairing); the classic force
 /// for Kim 2018 and for the converged solves (anderson, exact), where it is −∇U* of the

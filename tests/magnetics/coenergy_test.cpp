@@ -162,6 +162,14 @@ TEST_CASE("curve energy density: Psi' = |f^-1|, Psi ~ |M|^2/6 at small M", "[coe
     CHECK(curve_energy_density(Curve::Kim, M, Ms) == Approx(M * M / 6.0).epsilon(1e-15));
   }
   CHECK(curve_energy_density(Curve::Tanh, 1e-4 * Ms, Ms) == Approx(1e-8 * Ms * Ms / 6.0).epsilon(1e-8));
+  // the iron sphere: Ψ' = |f⁻¹(M)| = Ms(atanh(x)/χ + x/3), read from |H| where f(H) = M
+  for (double h : {1e-4, 0.05, 0.2, 0.3, 0.33}) {
+    const double M = curve_M(Curve::Iron, Vec3(0, 0, h * Ms), Ms).z(), d = 1e-7 * Ms;
+    const double dPsi = (curve_energy_density(Curve::Iron, M + d, Ms) -
+                         curve_energy_density(Curve::Iron, M - d, Ms)) / (2 * d);
+    INFO("|H|/Ms " << h << ", |M|/Ms " << M / Ms);
+    CHECK(dPsi == Approx(h * Ms).epsilon(1e-6));
+  }
   // at saturation Ψ = (Ms²/3) ln 2, finite
   CHECK(curve_energy_density(Curve::Tanh, Ms, Ms) == Approx(Ms * Ms * std::log(2.0) / 3.0).epsilon(1e-14));
 }
@@ -253,6 +261,21 @@ TEST_CASE("classic force with the near-field pair model is -grad U*", "[coenergy
                      << " torque " << r.worst_torque);
     CHECK(r.worst_force < 1e-6);
     CHECK(r.worst_torque < 1e-6);
+  }
+  SECTION("the iron curve, with its own widening") {
+    FieldOptions f;
+    f.near_field.model = NearField::Pair;
+    f.near_field.curve = Curve::Iron;
+    for (double strength : {0.3, 30.0}) {
+      MomentSet s = random_set(10, 5, strength, 2.5);
+      s.position[1] = s.position[0] + 2.003 * kBallRadius * Vec3(0.6, -0.48, 0.64);
+      s.position[3] = s.position[2] + 2.05 * kBallRadius * Vec3(0, 0.8, -0.6);
+      s.position[5] = s.position[4] + 2.4 * kBallRadius * Vec3(0.36, 0.48, 0.8);
+      const Check r = check_gradient(s, Curve::Iron, f, ForceModel::Classic, 2e-8);
+      INFO("strength " << strength << ": force " << r.worst_force << " torque " << r.worst_torque);
+      CHECK(r.worst_force < 1e-6);
+      CHECK(r.worst_torque < 1e-6);
+    }
   }
   SECTION("eq. 7's curve") {
     FieldOptions f;

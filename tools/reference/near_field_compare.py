@@ -12,7 +12,8 @@ force and moment ratios model / FEM for every pair cell and every chain.
 Each case is the FEM's arrangement in SI (a = 5 mm, Ms = 1.6e6 A/m, balls centred at
 (i - (N-1)/2)(2 + g) a on the z axis, H0 along z), solved by magsolve --method exact
 --force-model classic --mu-r 1000 (the Newton solution of the engine's tanh curve, the
-classic force -grad U*). Ratios of 1 are exact; the pair model's mark is 0.85-1.15 for pairs
+classic force -grad U*; --curve iron: the Newton solution of a sphere of the reference's own
+bulk iron, magnetics/types.hpp). Ratios of 1 are exact; the pair model's mark is 0.85-1.15 for pairs
 and 25 % for chains (end ball's force, chain moment). Prints markdown tables; a chain's
 "middle ball" is the innermost one of its upper half with a non-zero force."""
 import argparse
@@ -32,7 +33,7 @@ V = 4.0 / 3.0 * math.pi * A ** 3
 MODELS = ("dipole", "pair")
 
 
-def magsolve(exe, n, gap, h0, model, tmp):
+def magsolve(exe, n, gap, h0, model, tmp, curve="tanh"):
     """(z forces on every ball, N; total moment along z, A m^2) from magsolve."""
     d = (2.0 + gap) * A
     case = {"external_field": [0, 0, h0 * MS],
@@ -42,14 +43,14 @@ def magsolve(exe, n, gap, h0, model, tmp):
     with open(path, "w") as fh:
         json.dump(case, fh)
     out = subprocess.run([exe, path, "--method", "exact", "--force-model", "classic", "--near-field", model,
-                          "--mu-r", "1000"], check=True, capture_output=True, text=True).stdout
+                          "--mu-r", "1000", "--curve", curve], check=True, capture_output=True, text=True).stdout
     js = json.loads(out)
     F = [m["F_model"][2] for m in js["moments"]]
     mom = sum(V * m["M"][2] for m in js["moments"])
     return F, mom
 
 
-def compare(fem, exe):
+def compare(fem, exe, curve="tanh"):
     """One row per FEM ball with a non-zero force: the FEM force and moment, and each model's
     force, force / FEM and moment / FEM (magsolve per arrangement and model)."""
     rows = list(csv.DictReader(open(fem)))
@@ -59,7 +60,7 @@ def compare(fem, exe):
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         for (n, gap, h0), balls in groups.items():
-            res = {m: magsolve(exe, n, gap, h0, m, tmp) for m in MODELS}
+            res = {m: magsolve(exe, n, gap, h0, m, tmp, curve) for m in MODELS}
             mom_fem = float(balls[0]["chain_moment_Am2"])
             for b in balls:
                 k = int(b["ball"])
@@ -82,10 +83,12 @@ def main(argv=None):
     ap.add_argument("--fem", default=os.path.join(here, "data", "near_field_fem.csv"))
     nfcommon.add_magsolve(ap)
     ap.add_argument("--out", default=os.path.join(here, "data", "near_field_compare.csv"))
+    ap.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
+                    help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
     args = ap.parse_args(argv)
     if nfcommon.magsolve_missing(args.magsolve, "near_field_compare.py"):
         return 2
-    out = compare(args.fem, args.magsolve)
+    out = compare(args.fem, args.magsolve, args.curve)
     with open(args.out, "w", newline="") as fh:
         wr = csv.DictWriter(fh, fieldnames=list(out[0].keys()))
         wr.writeheader()
