@@ -79,3 +79,15 @@ def test_a_count_that_cannot_fit_is_refused(magsim, tmp_path):
     with pytest.raises(ValueError) as e:
         magsim.Scene.from_registry("balls_up", count=1000000000)
     assert str(e.value) == cli_error(err)
+
+
+def test_iron_curve_needs_a_converged_method(magsim, small):
+    small.set_option("magnetics.field.near_field.curve", "iron")
+    small.set_option("magnetics.method", "ours")
+    with pytest.raises(magsim.SceneError, match=r"near_field\.curve: iron needs method anderson or exact"):
+        magsim.Simulation(small)
+    with pytest.raises(ValueError, match=r"unknown curve 'kim' \(tanh, iron\)"):
+        small.set_option("magnetics.field.near_field.curve", "kim")
+    small.set_option("magnetics.method", "anderson")
+    sim = magsim.Simulation(small)
+    sim.step(2)
