@@ -45,8 +45,9 @@ ISSUE_GAPS = (0.003, 0.3)  # the pair mark's range of gaps
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def magsolve_force(magsolve, gap, H0, model, tmp):
-    """z force (N) on the upper of two balls at gap g (radii) in the field H0 (A/m vector)."""
+def magsolve_force(magsolve, gap, H0, model, tmp, curve="tanh"):
+    """z force (N) on the upper of two balls at gap g (radii) in the field H0 (A/m vector), on
+    magsolve's --curve (tanh: eq. 10; iron: a sphere of the reference's bulk iron)."""
     d = (2.0 + gap) * A
     V = 4.0 / 3.0 * math.pi * A ** 3
     case = {"external_field": list(H0),
@@ -56,7 +57,7 @@ def magsolve_force(magsolve, gap, H0, model, tmp):
     with open(path, "w") as fh:
         json.dump(case, fh)
     out = subprocess.run([magsolve, path, "--method", "exact", "--force-model", "classic",
-                          "--near-field", model, "--mu-r", str(MU_R)],
+                          "--near-field", model, "--mu-r", str(MU_R), "--curve", curve],
                          check=True, capture_output=True, text=True).stdout
     return json.loads(out)["moments"][1]["F_model"][2]
 

@@ -5,7 +5,7 @@ exact linear two-sphere force (two_spheres.py, mu_r = 1000), and how far into th
 linear solution stays a valid reference.
 
     /usr/bin/python3 tools/reference/near_field_transverse.py [--magsolve build/release/tools/magsolve]
-        [--out tools/reference/data/near_field_transverse.csv]
+        [--out tools/reference/data/near_field_transverse.csv] [--curve tanh|iron]
 
 Each case: a = 5 mm, Ms = 1.6e6 A/m, balls at z = -+d/2, d = (2 + g) a, H0 = h Ms along x;
 magsolve --method exact --force-model classic --mu-r 1000 (the Newton solution of the
@@ -77,6 +77,8 @@ def main(argv=None):
     here = os.path.dirname(os.path.abspath(__file__))
     nfcommon.add_magsolve(ap)
     ap.add_argument("--out", default=os.path.join(here, "data", "near_field_transverse.csv"))
+    ap.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
+                    help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
     args = ap.parse_args(argv)
     if nfcommon.magsolve_missing(args.magsolve, "near_field_transverse.py"):
         return 2
@@ -95,7 +97,7 @@ def main(argv=None):
                      "Hin_max_over_H0": hin, "h_lin_1pct": X_ONE_PERCENT / ((MU_R - 1) * hin),
                      "Hin_max_over_H0_axial": hin_ax, "h_lin_1pct_axial": X_ONE_PERCENT / ((MU_R - 1) * hin_ax)}
                 for model in nfc.MODELS:
-                    f = nfc.magsolve_force(args.magsolve, g, (H, 0.0, 0.0), model, tmp) / unit
+                    f = nfc.magsolve_force(args.magsolve, g, (H, 0.0, 0.0), model, tmp, args.curve) / unit
                     r[f"F_{model}_mu0H0^2a^2"] = f
                     r[f"{model}_over_exact"] = f / exact
                 rows.append(r)
@@ -106,7 +108,7 @@ def main(argv=None):
         for r in rows:
             wr.writerow({k: (f"{v:.7g}" if isinstance(v, float) else v) for k, v in r.items()})
 
-    print("transverse, model / exact linear force (upper ball; pair | dipole), mu_r = 1000:\n")
+    print(f"transverse, model / exact linear force (upper ball; pair | dipole), mu_r = 1000, curve {args.curve}:\n")
     print("| g/a | exact (mu0 H0^2 a^2) | " + " | ".join(f"{h:g} Ms" for h in FIELDS) + " |")
     print("|---" * (len(FIELDS) + 2) + "|")
     worst = 0.0
