@@ -3,7 +3,7 @@
 engine's force (magsolve, classic, --near-field dipole and pair) against our references, as
 CSV and PNG charts (headless: matplotlib's Agg backend).
 
-    /usr/bin/python3 tools/reference/near_field_chart.py --out DIR [--magsolve PATH] [--fem CSV]
+    /usr/bin/python3 tools/reference/near_field_chart.py --out DIR [--magsolve PATH] [--fem CSV] [--curve tanh|iron]
 
 1. Linear (weak field, H0 = 1e-4 Ms): force / exact two-sphere force (two_spheres.py, same
    mu_r) against the gap, axial and transverse: DIR/near_field_linear.csv.
@@ -18,7 +18,7 @@ CSV and PNG charts (headless: matplotlib's Agg backend).
    median and worst |ratio - 1|). tools/scripts/charts.py draws it beside the cost per step
    (bench --near-field-cost) as near_field_tradeoff.png.
 Balls of radius 5 mm, Ms = 1.6e6 A/m, mu_r = 1000; magsolve --method exact (the Newton
-solution of the tanh curve). Forces on the upper ball; ratios of 1 are exact. Marks:
+solution of the tanh curve; --curve iron: of a sphere of the reference's own iron). Forces on the upper ball; ratios of 1 are exact. Marks:
 0.85-1.15 for pairs, 25 % for the chains' end ball and moment, 5 % in the linear range."""
 import argparse
 import csv
@@ -62,7 +62,7 @@ def magsolve_force(magsolve, gap, H0, model, tmp, curve="tanh"):
     return json.loads(out)["moments"][1]["F_model"][2]
 
 
-def linear_rows(magsolve):
+def linear_rows(magsolve, curve="tanh"):
     """[field, g, exact force (mu0 H0^2 a^2), dipole / exact, pair / exact] at H0 = 1e-4 Ms."""
     rows = []
     H = 1e-4 * MS
@@ -74,7 +74,7 @@ def linear_rows(magsolve):
                 exact, _ = ts.converged_force(MU_R, float(g), field, rtol=1e-7)
                 row = [field, float(g), exact]
                 for model in MODELS:
-                    row.append(magsolve_force(magsolve, float(g), H0, model, tmp) / unit / exact)
+                    row.append(magsolve_force(magsolve, float(g), H0, model, tmp, curve) / unit / exact)
                 rows.append(row)
     return rows
 
@@ -225,12 +225,14 @@ def main(argv=None):
     p.add_argument("--out", required=True)
     nfcommon.add_magsolve(p)
     p.add_argument("--fem", default=os.path.join(HERE, "data", "near_field_fem.csv"))
+    p.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
+                   help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
     args = p.parse_args(argv)
     if nfcommon.magsolve_missing(args.magsolve, "near_field_chart.py"):
         return 2
     os.makedirs(args.out, exist_ok=True)
-    lin = linear_rows(args.magsolve)
-    compared = nfc_compare.compare(args.fem, args.magsolve)
+    lin = linear_rows(args.magsolve, args.curve)
+    compared = nfc_compare.compare(args.fem, args.magsolve, args.curve)
     cells, gaps, fields = cell_rows(compared)
     chains = chain_rows(compared)
     acc = accuracy_rows(lin, cells, chains)
