@@ -61,7 +61,7 @@ std::string body_where(int i, const std::string& name) {
 // force law (Model::Resolved), so that no stage works them out again.
 Model::Resolved resolve(const SimOptions& o) {
   Model::Resolved r;
-  r.curve = mag::curve_of(o.magnetics.method, o.magnetics.field.near_field.curve);
+  r.curve = mag::curve_of(o.magnetics);
   r.force = mag::resolve_force_model(o.force_model, o.magnetics.method);
   // classic (−∇U*) and zeeman-total (−∇E_sys) are gradients of an energy; eq. 4 (zeeman) is not
   r.force_has_energy = r.force != mag::ForceModel::Zeeman;
@@ -83,11 +83,8 @@ void check_options(const SimOptions& o, const Vec3& H0) {
          "needs reaction_symmetric_forces (it removes the torque those forces leave)");
   if (o.sleep && o.magnetics.method == mag::Method::Exact)
     fail("options.sleep", "needs a relaxation method: exact re-solves every moment, a sleeping one too");
-  if (o.magnetics.field.near_field.curve == mag::Curve::Iron &&
-      mag::curve_of(o.magnetics.method, mag::Curve::Iron) != mag::Curve::Iron)
-    fail("options.magnetics.field.near_field.curve", std::string("iron needs method anderson or exact (") +
-                                                         mag::method_name(o.magnetics.method) +
-                                                         " keeps its own curve)");
+  if (const std::string e = mag::curve_error(o.magnetics.method, o.magnetics.field.near_field.curve); !e.empty())
+    fail("options.magnetics.field.near_field.curve", e);
   if (!finite(H0)) fail("H0", "must be finite (got " + fmt(H0) + ")");
   check_at_most("H0", H0.stableNorm(), limits::kMaxField, "A/m");
   // the pair model is a correction of U*: only the classic force is its gradient

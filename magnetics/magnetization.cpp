@@ -39,9 +39,8 @@ std::string validate(const DynamicsOptions& o) {
     e << "anderson_damping must be in (0, 1], got " << o.anderson_damping;
   else if (!(o.anderson_restart_growth > 1 && std::isfinite(o.anderson_restart_growth)))
     e << "anderson_restart_growth must be > 1, got " << o.anderson_restart_growth;
-  else if (o.field.near_field.curve == Curve::Iron && curve_of(o.method, Curve::Iron) != Curve::Iron)
-    e << "curve iron needs method anderson or exact (" << kMethodNames.name(o.method)
-      << " keeps its own curve), got method " << kMethodNames.name(o.method);
+  else if (const std::string c = curve_error(o.method, o.field.near_field.curve); !c.empty())
+    e << "curve: " << c;
   else {
     const std::string f = validate(o.field);
     if (!f.empty()) return f;
@@ -210,7 +209,7 @@ SweepStats magnetization_iteration(const MomentDesc& set, Magnetization* mz,
   }
   compute_fields(set, *mz, opt.field, &ws->H, nullptr, &ws->field);
   const long n = static_cast<long>(set.size());
-  const Curve curve = curve_of(opt.method, opt.field.near_field.curve);
+  const Curve curve = curve_of(opt);
   double max_change = 0.0, max_res = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_change, max_res)
   for (long j = 0; j < n; ++j) {
@@ -242,7 +241,7 @@ RelaxStats relax_magnetization(
     const MomentDesc& set, Magnetization* mz, const DynamicsOptions& opt, MagWorkspace* ws,
     const std::function<void(int, const Magnetization&)>& on_iteration) {
   if (opt.method == Method::Exact) {
-    const ExactStats ex = solve_exact(set, mz, curve_of(opt.method, opt.field.near_field.curve), opt.field);
+    const ExactStats ex = solve_exact(set, mz, curve_of(opt), opt.field);
     RelaxStats st;
     st.iterations = ex.newton_steps;
     st.converged = ex.converged;

@@ -65,6 +65,8 @@ struct DynamicsOptions {
 };
 inline constexpr NameTable<DynamicsOptions::Criterion, 2> kCriterionNames{
     {{DynamicsOptions::Criterion::Residual, "residual"}, {DynamicsOptions::Criterion::Change, "change"}}};
+/// The curve these options converge to: the method's, or the chosen one where it takes it.
+inline Curve curve_of(const DynamicsOptions& o) { return curve_of(o.method, o.field.near_field.curve); }
 
 /// History of the Anderson solve (Method::Anderson, magnetics/anderson.cpp). Vectors stack
 /// the induced magnetizations divided by Ms (3k entries for k induced moments); sized on the

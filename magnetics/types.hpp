@@ -68,10 +68,17 @@ inline constexpr NameTable<ForceModel, 4> kForceModelNames{{{ForceModel::Method,
 
 /// The curve a method converges to (Kim 2018 uses eq. 7, every other method eq. 10).
 inline Curve curve_of(Method m) { return m == Method::Kim2018 ? Curve::Kim : Curve::Tanh; }
-/// The curve a method converges to when `chosen` is asked for: Kim 2018 keeps eq. 7; anderson
-/// and exact take `chosen`; the θ dynamics keep eq. 10 (their γ_C is eq. 10's).
-inline Curve curve_of(Method m, Curve chosen) {
-  return m == Method::Anderson || m == Method::Exact ? chosen : curve_of(m);
+/// Whether a method converges to the curve the options choose: anderson and exact set
+/// M = f(H) for any f; Kim 2018 keeps eq. 7 and the θ dynamics eq. 10 (their γ_C is eq. 10's).
+inline bool takes_chosen_curve(Method m) { return m == Method::Anderson || m == Method::Exact; }
+/// The curve a method converges to when `chosen` is asked for.
+inline Curve curve_of(Method m, Curve chosen) { return takes_chosen_curve(m) ? chosen : curve_of(m); }
+/// Empty when method m may be asked for curve c, else why not, in one line (for the caller
+/// to prefix with the option's name): eq. 10 is every method's but Kim 2018's, iron only
+/// the methods that take a chosen curve.
+inline std::string curve_error(Method m, Curve c) {
+  if (c != Curve::Iron || takes_chosen_curve(m)) return {};
+  return std::string("iron needs method anderson or exact (") + kMethodNames.name(m) + " keeps its own curve)";
 }
 /// The force model a method is paired with: eq. 4 for the paper's θ dynamics and the
 /// damping-only LLG (ours, ours-realigned, damping-llg: the paper's pairing); the classic force

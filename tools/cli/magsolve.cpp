@@ -270,7 +270,7 @@ int run(int argc, char** argv) {
   }
 
   // ground truth of the method's curve
-  const mag::Curve curve = mag::curve_of(opt.method, opt.field.near_field.curve);
+  const mag::Curve curve = mag::curve_of(opt);
   mag::MomentSet gt = set;
   // long solves say what they are doing: the Newton reference factors a dense 3N x 3N
   // matrix per step (N = 3153: ~9 GB of arithmetic per step), on stderr
