@@ -225,8 +225,7 @@ def main(argv=None):
     p.add_argument("--out", required=True)
     nfcommon.add_magsolve(p)
     p.add_argument("--fem", default=os.path.join(HERE, "data", "near_field_fem.csv"))
-    p.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
-                   help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
+    nfcommon.add_curve(p)
     args = p.parse_args(argv)
     if nfcommon.magsolve_missing(args.magsolve, "near_field_chart.py"):
         return 2

@@ -13,6 +13,12 @@ def add_magsolve(parser):
     parser.add_argument("--magsolve", default=MAGSOLVE)
 
 
+def add_curve(parser):
+    """--curve: the balls' curve that magsolve solves on (magsolve --curve)."""
+    parser.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
+                        help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
+
+
 def magsolve_missing(path, prog):
     """True (and one line on stderr) when path is not an executable: build it first."""
     if os.access(path, os.X_OK):

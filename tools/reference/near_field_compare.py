@@ -83,8 +83,7 @@ def main(argv=None):
     ap.add_argument("--fem", default=os.path.join(here, "data", "near_field_fem.csv"))
     nfcommon.add_magsolve(ap)
     ap.add_argument("--out", default=os.path.join(here, "data", "near_field_compare.csv"))
-    ap.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
-                    help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
+    nfcommon.add_curve(ap)
     args = ap.parse_args(argv)
     if nfcommon.magsolve_missing(args.magsolve, "near_field_compare.py"):
         return 2

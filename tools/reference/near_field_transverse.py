@@ -77,8 +77,7 @@ def main(argv=None):
     here = os.path.dirname(os.path.abspath(__file__))
     nfcommon.add_magsolve(ap)
     ap.add_argument("--out", default=os.path.join(here, "data", "near_field_transverse.csv"))
-    ap.add_argument("--curve", choices=("tanh", "iron"), default="tanh",
-                    help="the balls' curve (magsolve --curve): tanh = eq. 10, iron = a sphere of the reference's iron")
+    nfcommon.add_curve(ap)
     args = ap.parse_args(argv)
     if nfcommon.magsolve_missing(args.magsolve, "near_field_transverse.py"):
         return 2
