@@ -242,37 +242,26 @@ TEST_CASE("classic force is -grad U* with softening and with bounded pairs", "[c
 
 TEST_CASE("classic force with the near-field pair model is -grad U*", "[coenergy][near_field]") {
   // pairs at gaps of 0.003a, 0.05a, 0.4a and 1.4a (the cut-off step), in the fade's range
-  // (weak magnet) and saturated (strong): the forces on balls and magnet, the magnet's torque
-  for (double strength : {0.3, 30.0}) {
-    FieldOptions f;
-    f.near_field.model = NearField::Pair;
-    MomentSet s = random_set(10, 5, strength, 2.5);
-    const double a = kBallRadius;
-    s.position[1] = s.position[0] + 2.003 * a * Vec3(0.6, -0.48, 0.64);
-    s.position[3] = s.position[2] + 2.05 * a * Vec3(0, 0.8, -0.6);
-    s.position[5] = s.position[4] + 2.4 * a * Vec3(0.36, 0.48, 0.8);
-    s.position[7] = s.position[6] + 3.4 * a * Vec3(1, 0, 0);
-    NearFieldWorkspace nws;
-    find_near_pairs(s, &nws);
-    REQUIRE(nws.pairs.size() >= 4);
-    // steps of 20 nm: the closest pair's force changes on the scale of its 15 µm gap
-    const Check r = check_gradient(s, Curve::Tanh, f, ForceModel::Classic, 2e-8);
-    INFO("strength " << strength << ": " << nws.pairs.size() << " near pairs; force " << r.worst_force
-                     << " torque " << r.worst_torque);
-    CHECK(r.worst_force < 1e-6);
-    CHECK(r.worst_torque < 1e-6);
-  }
-  SECTION("the iron curve, with its own widening") {
-    FieldOptions f;
-    f.near_field.model = NearField::Pair;
-    f.near_field.curve = Curve::Iron;
+  // (weak magnet) and saturated (strong): the forces on balls and magnet, the magnet's torque;
+  // on eq. 10's curve and on the iron sphere's, each with its own widening
+  for (const Curve curve : {Curve::Tanh, Curve::Iron}) {
     for (double strength : {0.3, 30.0}) {
+      FieldOptions f;
+      f.near_field.model = NearField::Pair;
+      f.near_field.curve = curve;
       MomentSet s = random_set(10, 5, strength, 2.5);
-      s.position[1] = s.position[0] + 2.003 * kBallRadius * Vec3(0.6, -0.48, 0.64);
-      s.position[3] = s.position[2] + 2.05 * kBallRadius * Vec3(0, 0.8, -0.6);
-      s.position[5] = s.position[4] + 2.4 * kBallRadius * Vec3(0.36, 0.48, 0.8);
-      const Check r = check_gradient(s, Curve::Iron, f, ForceModel::Classic, 2e-8);
-      INFO("strength " << strength << ": force " << r.worst_force << " torque " << r.worst_torque);
+      const double a = kBallRadius;
+      s.position[1] = s.position[0] + 2.003 * a * Vec3(0.6, -0.48, 0.64);
+      s.position[3] = s.position[2] + 2.05 * a * Vec3(0, 0.8, -0.6);
+      s.position[5] = s.position[4] + 2.4 * a * Vec3(0.36, 0.48, 0.8);
+      s.position[7] = s.position[6] + 3.4 * a * Vec3(1, 0, 0);
+      NearFieldWorkspace nws;
+      find_near_pairs(s, &nws);
+      REQUIRE(nws.pairs.size() >= 4);
+      // steps of 20 nm: the closest pair's force changes on the scale of its 15 µm gap
+      const Check r = check_gradient(s, curve, f, ForceModel::Classic, 2e-8);
+      INFO(kCurveNames.name(curve) << ", strength " << strength << ": " << nws.pairs.size()
+                                   << " near pairs; force " << r.worst_force << " torque " << r.worst_torque);
       CHECK(r.worst_force < 1e-6);
       CHECK(r.worst_torque < 1e-6);
     }
