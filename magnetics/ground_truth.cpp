@@ -106,6 +106,11 @@ ExactStats solve_exact(const MomentDesc& set, Magnetization* mz, Curve curve,
   }
   Eigen::VectorXd M(3 * k), H;
   for (int a = 0; a < k; ++a) M.segment<3>(3 * a) = mz->M[P.idx[a]];
+  // an unmagnetized start begins from each ball alone in the applied field: from M = 0 a
+  // stiff curve (Curve::Iron) can send Newton to |M| ≈ Ms, where the pair model's saturation
+  // is clamped flat and ‖R‖ stalls
+  if (M.squaredNorm() == 0.0)
+    for (int a = 0; a < k; ++a) M.segment<3>(3 * a) = curve_M(curve, P.Hb.segment<3>(3 * a), set.Ms[P.idx[a]]);
   Near nf{&field.near_field, {}, *mz, {}};
   std::vector<int> slot(set.size(), -1);
   for (int a = 0; a < k; ++a) slot[P.idx[a]] = a;

@@ -103,25 +103,34 @@ PairCouplingTable::PairCouplingTable(double mu_r, Curve curve)
 }
 
 PairWidening pair_widening(Curve c) {
-  if (c == Curve::Iron) return {kPairWidenScaleIron, kPairWidenPowerIron};
+  if (c == Curve::Iron) return {kPairWidenScaleIron, kPairWidenPowerIron, kPairWidenShareIron, kPairWidenSharpIron};
   return {kPairWidenScale, kPairWidenPower};
 }
 
-namespace {
-// The saturated layer's width κ h^q (radii) and its h-derivative κ q h^{q−1}
-double widening(const PairWidening& k, double h, double* dw_dh) {
+// w = κ h^q; G = (1 − λ) g_e + B, B = (a^p + w^p)^{1/p}, a = λ g_e:
+// dG/dg_e = (1 − λ) + λ (a/B)^{p−1}, dG/dh = (w/B)^{p−1} κ q h^{q−1}
+double pair_blended_gap(const PairWidening& k, double ge, double h, double* dG_dge, double* dG_dh) {
   const double w = h > 0 ? k.scale * dmath::pow(h, k.power) : 0.0;
-  *dw_dh = h > 0 ? k.power * w / h : 0.0;
-  return w;
+  const double dw = h > 0 ? k.power * w / h : 0.0;
+  if (k.share == 0.0) {  // the sum, bit for bit
+    *dG_dge = 1.0;
+    *dG_dh = dw;
+    return ge + w;
+  }
+  const double a = k.share * ge;
+  const double big = std::max(a, w), small = std::min(a, w);
+  // B from the larger term, so that neither power overflows nor underflows to 0/0
+  const double B = big * dmath::pow(1.0 + dmath::pow(small / big, k.sharpness), 1.0 / k.sharpness);
+  *dG_dge = (1.0 - k.share) + k.share * dmath::pow(a / B, k.sharpness - 1.0);
+  *dG_dh = w > 0 ? dmath::pow(w / B, k.sharpness - 1.0) * dw : 0.0;
+  return (1.0 - k.share) * ge + B;
 }
-}  // namespace
 
-// G = g_e(g) + κ h^q (PHYSICS.md, "The near field"): dG/dg = dg_e/dg, dG/dh = κ q h^{q−1}
 double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh, Curve c) {
-  double dge = 0, dw = 0;
-  const double G = pair_effective_gap(g, &dge) + widening(pair_widening(c), h, &dw);
-  if (dG_dg) *dG_dg = dge;
-  if (dG_dh) *dG_dh = dw;
+  double dge = 0, dGge = 0, dGh = 0;
+  const double G = pair_blended_gap(pair_widening(c), pair_effective_gap(g, &dge), h, &dGge, &dGh);
+  if (dG_dg) *dG_dg = dGge * dge;
+  if (dG_dh) *dG_dh = dGh;
   return G;
 }
 
@@ -141,18 +150,19 @@ PairCoupling PairCouplingTable::at(double g, double h) const {
   return at_effective(ge, dge, h);
 }
 
-// G = g_e + κ h^q as pair_widened_gap, from g_e and dg_e/dg
+// G as pair_widened_gap, from g_e and dg_e/dg
 PairCoupling PairCouplingTable::at_effective(double ge, double dge_dg, double h) const {
-  double dGh = 0;
-  const double G = ge + widening(widen_, h, &dGh);
+  double dGge = 0, dGh = 0;
+  const double G = pair_blended_gap(widen_, ge, h, &dGge, &dGh);
+  const double dGg = dGge * dge_dg;
   const double x = dmath::log(G);
   PairCoupling c;
   double d = 0;
   spline_eval(par_, par2_, x, &c.par, &d);
-  c.dpar = d * dge_dg / G;
+  c.dpar = d * dGg / G;
   c.dpar_dh = d * dGh / G;
   spline_eval(perp_, perp2_, x, &c.perp, &d);
-  c.dperp = d * dge_dg / G;
+  c.dperp = d * dGg / G;
   c.dperp_dh = d * dGh / G;
   return c;
 }

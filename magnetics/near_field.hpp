@@ -7,7 +7,7 @@
 // field it repels up to 42 % too strongly (magnetics/PHYSICS.md, "The near field"). The pair
 // model adds to every pair of induced spheres closer than kPairCutoffGap the energy
 //   E_ij = −μ0 S(g) ν^−β m_iᵀ ΔT(r_ij) m_j,
-//   ΔT(r) = [Δt∥(G) r̂ r̂ᵀ + Δt⊥(G) (I − r̂ r̂ᵀ)] / a³,   G = g_e(g) + κ h^q,   h = h(ζ̄),
+//   ΔT(r) = [Δt∥(G) r̂ r̂ᵀ + Δt⊥(G) (I − r̂ r̂ᵀ)] / a³,   G = G(g_e(g), κ h^q),   h = h(ζ̄),
 // in the co-energy's pair sum (coenergy.hpp), so that every force stays −∇U*:
 //   * Δt∥, Δt⊥: the exact two-sphere coupling corrections (tools/reference/
 //     near_field_table.py) that make the pair's linear polarizability C∥(d), C⊥(d) exact for
@@ -21,15 +21,17 @@
 //   * S(g): 1 for g ≤ kPairFullGap, a quintic step to 0 at kPairCutoffGap (C² throughout);
 //   * G: the saturated contact read as a wider gap (PHYSICS.md, "The near field"). Where the
 //     gap's flux density would exceed μ0 Ms the iron cannot carry it and acts as air, so the
-//     correction is the exact linear one at G = g_e + κ h^q. The flux is the balls' own:
+//     correction is the exact linear one at a gap G widened by the saturated layer κ h^q
+//     (G = g_e + κ h^q on eq. 10's balls, a blend of the two on the iron's: PairWidening).
+//     The flux is the balls' own:
 //     h = ζ̄ / (3 √(1 − ζ̄²)), ζ̄ = (|M_i|/Ms_i + |M_j|/Ms_j)/2 (pair_flux_field), the field in
 //     Ms that magnetizes a lone ball to ζ̄ to first order (ζ ≈ 3h), growing without bound as
 //     the iron saturates. A contact in a chain, whose balls carry the chain's flux, thus
 //     saturates at a lower applied field than a lone pair. κ and q are fitted to the
 //     nonlinear finite-element table (tools/findings/near_field_reference.md), once per
 //     curve of the balls (pair_widening). At low field
-//     G = g_e and the pair is exact linear; dG/dg = dg_e/dg > 0 and Δt falls with the gap,
-//     so the correction always attracts;
+//     G = g_e and the pair is exact linear; dG/dg ≥ (1 − λ) dg_e/dg > 0 and Δt falls with
+//     the gap, so the correction always attracts;
 //   * ν: the contacts the pair shares its balls' flux with, ν = 1 + (n_i + n_j)/2 − S_c(g),
 //     n_i = Σ_k S_c(g_ik) the smooth contact count of ball i (S_c: 1 up to kPairCountFullGap,
 //     a quintic step to 0 at kPairCountCutoffGap). ν = 1 for a lone pair, 1.5 for a chain's
@@ -83,8 +85,10 @@ inline constexpr double kPairContactGap = 1.5e-3; ///< g_m: what contact reads a
 inline constexpr double kPairSmoothGap = 5e-4;    ///< g_s: the width of the step to g_m
 inline constexpr double kPairWidenScale = 0.3425;  ///< κ (gap widening per h^q, radii), eq. 10's balls
 inline constexpr double kPairWidenPower = 1.277;   ///< q (κ and q fitted to the FEM table)
-inline constexpr double kPairWidenScaleIron = 0.7399;  ///< κ of Curve::Iron's balls
-inline constexpr double kPairWidenPowerIron = 1.527;   ///< q of Curve::Iron's balls
+inline constexpr double kPairWidenScaleIron = 0.4497;  ///< κ of Curve::Iron's balls
+inline constexpr double kPairWidenPowerIron = 1.462;   ///< q of Curve::Iron's balls
+inline constexpr double kPairWidenShareIron = 0.3466;  ///< λ of Curve::Iron's balls (the blend below)
+inline constexpr double kPairWidenSharpIron = 6.356;   ///< p of Curve::Iron's balls
 inline constexpr double kPairCountFullGap = 0.5;  ///< S_c = 1 up to this gap
 inline constexpr double kPairCountCutoffGap = 1.0; ///< S_c = 0 from this gap on
 inline constexpr double kPairShareCoupling = 0.4;  ///< β: the coupling ν^−β
@@ -92,15 +96,25 @@ inline constexpr double kPairShareCoupling = 0.4;  ///< β: the coupling ν^−�
 /// g_e of a gap g and dg_e/dg.
 double pair_effective_gap(double g, double* dge_dg = nullptr);
 
-/// κ and q of the widening κ h^q for balls of curve c. Fitted per curve on the same training
-/// half: a weaker curve magnetizes the balls less, and its fit had absorbed that.
+/// The widening of balls of curve c: the saturated layer w = κ h^q and how it meets the gap,
+///   G = (1 − λ) g_e + (λ^p g_e^p + w^p)^{1/p}   (λ = 0: G = g_e + w),
+/// a layer thinner than about λ g_e widens nothing (the gap's own flux is too weak to
+/// saturate the iron there), one much thicker adds to (1 − λ) g_e. dG/dg_e ≥ 1 − λ > 0, so
+/// the correction attracts at every gap. Fitted per curve on the same training half: eq. 10's
+/// balls keep the sum (λ = 0); the iron's knee (g = 0.03a–0.1a at 0.03–0.1 Ms) needs the
+/// blend.
 struct PairWidening {
-  double scale, power;
+  double scale, power;        ///< κ, q
+  double share = 0.0;         ///< λ ∈ [0, 1)
+  double sharpness = 1.0;     ///< p ≥ 1
 };
 PairWidening pair_widening(Curve c);
 
-/// The widened gap G = g_e(g) + κ h^q (radii) of a gap g at the saturation field h ≥ 0
-/// (pair_flux_field), with dG/dg and dG/dh; κ, q of curve c.
+/// G of an effective gap g_e at the saturation field h ≥ 0, with dG/dg_e and dG/dh.
+double pair_blended_gap(const PairWidening& k, double ge, double h, double* dG_dge, double* dG_dh);
+
+/// The widened gap G (radii) of a gap g at the saturation field h ≥ 0 (pair_flux_field), with
+/// dG/dg and dG/dh; the widening of curve c.
 double pair_widened_gap(double g, double h, double* dG_dg = nullptr, double* dG_dh = nullptr,
                         Curve c = Curve::Tanh);
 

@@ -7,6 +7,7 @@ g = 0.003a, 3- and 5-chains at 0.01a and 0.03a).
 
     /usr/bin/python3 tools/reference/near_field_flux_fit.py [--fem tools/reference/data/near_field_fem.csv]
         [--chains tools/reference/data/near_field_fem_chains.csv] [--no-fit] [--curve tanh|sphere]
+        [--widen sum|blend]
 
 The model, on the axis (every moment along z; M in Ms, moments m = V Ms M):
     U(M; z)/mu0 = sum V Ms^2 Psi(M_i) - sum m_i H0 - sum_{i<j} m_i m_j K_ij(z, M),
@@ -19,7 +20,9 @@ M-derivative by central differences), and the forces are -dU/dz at fixed M (the 
 theorem, by central differences). `--no-fit` evaluates the engine's
 constants only. `--curve sphere` swaps the engine's curve for the law of a sphere of the
 reference's own bulk iron, M = Ms tanh(999 (H - M/3)/Ms) (Psi' = atanh(M)/999 + M/3); its U
-is not convex in M near Ms, so M is the least-U stationary point from four starts. Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
+is not convex in M near Ms, so M is the least-U stationary point from four starts. `--widen
+blend` swaps G = g_e + kappa h^q for the blend G = (1 - lambda) g_e + ((lambda g_e)^p +
+(kappa h^q)^p)^(1/p) and fits lambda and p with kappa and q (the engine's iron balls). Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
 evaluated beside it on the same chains."""
 import argparse
 import math
@@ -44,6 +47,25 @@ DT_TAIL = float(nf.SPLINE(math.log(G_TAIL)))
 LAMBDA = float(nf.SPLINE(math.log(G_TAIL), 1)) / DT_TAIL
 CHI = 999.0  # the reference's iron: mu_r,initial 1000
 CURVE = "tanh"  # the balls' curve: tanh = the engine's eq. 10; sphere = the reference's iron
+
+
+def widen_sum(ge, w0):
+    """eq. 10's widened gap: G = g_e + w0, w0 = kappa h^q."""
+    return ge + w0
+
+
+def widen_blend(lam, p):
+    """The iron's widened gap (magnetics/near_field.hpp, PairWidening):
+    G = (1 - lam) g_e + ((lam g_e)^p + w0^p)^(1/p); dG/dg_e >= 1 - lam > 0."""
+    def widen(ge, w0):
+        a = lam * ge
+        big, small = max(a, w0), min(a, w0)
+        return (1.0 - lam) * ge + big * (1.0 + (small / big) ** p) ** (1.0 / p)
+    return widen
+
+
+WIDEN = widen_sum
+ENGINE_BLEND = (0.4497, 1.462, 0.4, 0.3466, 6.356)  # kappa, q, beta, lambda, p: Curve::Iron
 
 
 def psi(M):
@@ -85,7 +107,7 @@ def kmat(z, M, par, h0=None):
                 ge, _ = nf.g_eff(gg[i, j])
                 if h0 is None:
                     kappa, q, beta = par
-                    G = ge + kappa * flux_field(0.5 * (abs(M[i]) + abs(M[j]))) ** q
+                    G = WIDEN(ge, kappa * flux_field(0.5 * (abs(M[i]) + abs(M[j]))) ** q)
                 else:
                     kappa, q, beta, gamma = par
                     G = ge + kappa * nu ** gamma * h0 ** q
@@ -155,6 +177,42 @@ def ratios(cells, keys, par, applied=False):
     return out
 
 
+BLEND_NAME = [""]
+
+
+def fit_blend(cells, train, chain_train):
+    """kappa, q, lambda, p on the pair training half (three Nelder-Mead starts; lambda in
+    (0, 1) and p > 1 through their logistic and exp), then beta on the 3- and 4-chains."""
+    global WIDEN
+
+    def unpack(x):
+        return math.exp(x[0]), x[1], 1.0 / (1.0 + math.exp(-x[2])), 1.0 + math.exp(x[3])
+
+    def loss(x):
+        global WIDEN
+        kappa, q, lam, p = unpack(x)
+        if not 0.3 < q < 3:
+            return 1e9
+        WIDEN = widen_blend(lam, p)
+        try:
+            return wt.ssq(ratios(cells, train, (kappa, q, 0.4)))
+        except RuntimeError:  # no stationary magnetization found at this trial point
+            return 1e9
+    starts = ([math.log(0.59), 1.3, 0.0, 0.0], [math.log(0.74), 1.5, 1.0, 1.0], [math.log(0.4), 1.2, -1.0, -1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        best = min((minimize(loss, x0, method="Nelder-Mead", options={"xatol": 1e-3, "fatol": 1e-5, "maxiter": 400})
+                    for x0 in starts), key=lambda res: res.fun)
+    kappa, q, lam, p = unpack(best.x)
+    WIDEN = widen_blend(lam, p)
+    grid = [(wt.ssq(ratios(cells, chain_train, (kappa, q, b)), ("end", "moment")), b) for b in np.arange(0.0, 1.01, 0.1)]
+    beta = min(grid)[1]
+    BLEND_NAME[0] = f", lambda {lam:.4g}, p {p:.4g}"
+    print(f"fitted: kappa {kappa:.4g}, q {q:.4g}, lambda {lam:.4g}, p {p:.4g} (pair training half), beta {beta:.1f} "
+          f"(3- and 4-chains at 0.003a); the engine's iron has {ENGINE_BLEND}")
+    return (kappa, q, beta)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--fem", default=os.path.join(HERE, "data", "near_field_fem.csv"))
@@ -162,8 +220,11 @@ def main(argv=None):
     ap.add_argument("--no-fit", action="store_true", help="the engine's constants only")
     ap.add_argument("--curve", choices=("tanh", "sphere"), default="tanh",
                     help="the balls' curve: tanh (the engine's eq. 10) or sphere (the reference's bulk iron)")
+    ap.add_argument("--widen", choices=("sum", "blend"), default="sum",
+                    help="the widened gap: sum (g_e + kappa h^q, eq. 10's balls) or blend (lambda and p "
+                         "fitted too; the engine's iron balls)")
     args = ap.parse_args(argv)
-    global CURVE
+    global CURVE, WIDEN
     CURVE = args.curve
     cells = nf.load_fem(args.fem)
     cells.update(nf.load_fem(args.chains))
@@ -174,7 +235,13 @@ def main(argv=None):
     chains = sorted(k for k in cells if k[0] > 2)
     chain_train = [c for c in chains if c[1] == 0.003 and c[0] in (3, 4)]
     par = ENGINE
-    if not args.no_fit:
+    if args.widen == "blend":
+        par = ENGINE_BLEND[:3]
+        WIDEN = widen_blend(*ENGINE_BLEND[3:])
+        BLEND_NAME[0] = f", lambda {ENGINE_BLEND[3]:.4g}, p {ENGINE_BLEND[4]:.4g}"
+        if not args.no_fit:
+            par = fit_blend(cells, train, chain_train)
+    elif not args.no_fit:
         def loss(x):  # beta does not enter a lone pair (nu = 1)
             return 1e9 if not 0.3 < x[1] < 3 else wt.ssq(ratios(cells, train, (math.exp(x[0]), x[1], 0.4)))
         best = min((minimize(loss, x0, method="Nelder-Mead", options={"xatol": 1e-3, "fatol": 1e-5, "maxiter": 200})
@@ -185,7 +252,7 @@ def main(argv=None):
         par = (kappa, q, min(grid)[1])
         print(f"fitted: kappa {par[0]:.4g}, q {par[1]:.4g} (pair training half), beta {par[2]:.1f} "
               f"(3- and 4-chains at 0.003a); the engine has {ENGINE}")
-    name = f"flux (kappa {par[0]:.4g}, q {par[1]:.4g}, beta {par[2]:.1f})"
+    name = f"flux (kappa {par[0]:.4g}, q {par[1]:.4g}, beta {par[2]:.1f}{BLEND_NAME[0]})"
     wt.print_pairs(name, ratios(cells, pairs, par), gaps, fields, train)
     wt.print_chains(name + "; training: N = 3, 4 at 0.003a", ratios(cells, chains, par), chains)
     wt.print_chains("candidate C (h = H0/Ms)", ratios(cells, chains, CANDIDATE_C, applied=True), chains)
