@@ -205,8 +205,12 @@ def fit_blend(cells, train, chain_train):
                     for x0 in starts), key=lambda res: res.fun)
     kappa, q, lam, p = unpack(best.x)
     WIDEN = widen_blend(lam, p)
-    grid = [(wt.ssq(ratios(cells, chain_train, (kappa, q, b)), ("end", "moment")), b) for b in np.arange(0.0, 1.01, 0.1)]
-    beta = min(grid)[1]
+    def chain_loss(b):
+        try:
+            return wt.ssq(ratios(cells, chain_train, (kappa, q, b)), ("end", "moment"))
+        except RuntimeError:
+            return math.inf
+    beta = min((chain_loss(b), b) for b in np.arange(0.0, 1.01, 0.1))[1]
     BLEND_NAME[0] = f", lambda {lam:.4g}, p {p:.4g}"
     print(f"fitted: kappa {kappa:.4g}, q {q:.4g}, lambda {lam:.4g}, p {p:.4g} (pair training half), beta {beta:.1f} "
           f"(3- and 4-chains at 0.003a); the engine's iron has {ENGINE_BLEND}")
