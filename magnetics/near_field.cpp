@@ -103,12 +103,13 @@ PairCouplingTable::PairCouplingTable(double mu_r, Curve curve)
 }
 
 PairWidening pair_widening(Curve c) {
-  if (c == Curve::Iron) return {kPairWidenScaleIron, kPairWidenPowerIron, kPairWidenShareIron, kPairWidenSharpIron};
+  if (c == Curve::Iron) return {kPairWidenScaleIron, kPairWidenPowerIron, kPairWidenShareIron};
   return {kPairWidenScale, kPairWidenPower};
 }
 
-// w = κ h^q; G = (1 − λ) g_e + B, B = (a^p + w^p)^{1/p}, a = λ g_e:
-// dG/dg_e = (1 − λ) + λ (a/B)^{p−1}, dG/dh = (w/B)^{p−1} κ q h^{q−1}
+// w = κ h^q; G = (1 − λ) g_e + B, B = (a⁴ + w⁴)^{1/4} = big s^{1/4}, a = λ g_e,
+// s = 1 + r⁴, r = small/big ≤ 1: dG/dg_e = (1 − λ) + λ (a/B)³, dG/dh = (w/B)³ κ q h^{q−1},
+// (big/B)³ = s^{1/4}/s and (small/B)³ = r³ s^{1/4}/s
 double pair_blended_gap(const PairWidening& k, double ge, double h, double* dG_dge, double* dG_dh) {
   const double w = h > 0 ? k.scale * dmath::pow(h, k.power) : 0.0;
   const double dw = h > 0 ? k.power * w / h : 0.0;
@@ -117,13 +118,14 @@ double pair_blended_gap(const PairWidening& k, double ge, double h, double* dG_d
     *dG_dh = dw;
     return ge + w;
   }
-  const double a = k.share * ge;
-  const double big = std::max(a, w), small = std::min(a, w);
-  // B from the larger term, so that neither power overflows nor underflows to 0/0
-  const double B = big * dmath::pow(1.0 + dmath::pow(small / big, k.sharpness), 1.0 / k.sharpness);
-  *dG_dge = (1.0 - k.share) + k.share * dmath::pow(a / B, k.sharpness - 1.0);
-  *dG_dh = w > 0 ? dmath::pow(w / B, k.sharpness - 1.0) * dw : 0.0;
-  return (1.0 - k.share) * ge + B;
+  const double a = k.share * ge;  // > 0: g_e ≥ g_m
+  const bool a_big = a >= w;
+  const double big = a_big ? a : w, r = (a_big ? w : a) / big, r2 = r * r;
+  const double s = 1.0 + r2 * r2, root = std::sqrt(std::sqrt(s));
+  const double c_big = root / s, c_small = r2 * r * root / s;
+  *dG_dge = (1.0 - k.share) + k.share * (a_big ? c_big : c_small);
+  *dG_dh = (a_big ? c_small : c_big) * dw;
+  return (1.0 - k.share) * ge + big * root;
 }
 
 double pair_widened_gap(double g, double h, double* dG_dg, double* dG_dh, Curve c) {

@@ -220,7 +220,7 @@ TEST_CASE("pair model, iron curve: axial pairs against the finite-element table"
 
 TEST_CASE("pair model, iron curve: chains of 3 and 5 on the axis", "[near_field]") {
   // End ball's force and the chain's moment within 25 % of the FEM (the cells of the tanh test
-  // above); with the iron curve the ball next to the 5-chain's end is within 0.75–1.21 ×.
+  // above); with the iron curve the ball next to the 5-chain's end is within 0.77–1.20 ×.
   struct Cell {
     int n;
     double h, F, m;

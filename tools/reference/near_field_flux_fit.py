@@ -7,7 +7,7 @@ g = 0.003a, 3- and 5-chains at 0.01a and 0.03a).
 
     /usr/bin/python3 tools/reference/near_field_flux_fit.py [--fem tools/reference/data/near_field_fem.csv]
         [--chains tools/reference/data/near_field_fem_chains.csv] [--no-fit] [--curve tanh|sphere]
-        [--widen sum|blend]
+        [--widen sum|blend [--fit-p]]
 
 The model, on the axis (every moment along z; M in Ms, moments m = V Ms M):
     U(M; z)/mu0 = sum V Ms^2 Psi(M_i) - sum m_i H0 - sum_{i<j} m_i m_j K_ij(z, M),
@@ -22,7 +22,8 @@ constants only. `--curve sphere` swaps the engine's curve for the law of a spher
 reference's own bulk iron, M = Ms tanh(999 (H - M/3)/Ms) (Psi' = atanh(M)/999 + M/3); its U
 is not convex in M near Ms, so M is the least-U stationary point from four starts. `--widen
 blend` swaps G = g_e + kappa h^q for the blend G = (1 - lambda) g_e + ((lambda g_e)^p +
-(kappa h^q)^p)^(1/p) and fits lambda and p with kappa and q (the engine's iron balls). Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
+(kappa h^q)^p)^(1/p), p = 4, and fits lambda with kappa and q (the engine's iron balls;
+`--fit-p` fits p too). Candidate C (the model before: h = H0/Ms, G = g_e + kappa nu^gamma h^q) is
 evaluated beside it on the same chains."""
 import argparse
 import math
@@ -54,9 +55,9 @@ def widen_sum(ge, w0):
     return ge + w0
 
 
-def widen_blend(lam, p):
+def widen_blend(lam, p=4.0):
     """The iron's widened gap (magnetics/near_field.hpp, PairWidening):
-    G = (1 - lam) g_e + ((lam g_e)^p + w0^p)^(1/p); dG/dg_e >= 1 - lam > 0."""
+    G = (1 - lam) g_e + ((lam g_e)^p + w0^p)^(1/p), p = 4 in the engine; dG/dg_e >= 1 - lam > 0."""
     def widen(ge, w0):
         a = lam * ge
         big, small = max(a, w0), min(a, w0)
@@ -65,7 +66,7 @@ def widen_blend(lam, p):
 
 
 WIDEN = widen_sum
-ENGINE_BLEND = (0.4497, 1.462, 0.4, 0.3466, 6.356)  # kappa, q, beta, lambda, p: Curve::Iron
+ENGINE_BLEND = (0.4274, 1.470, 0.4, 0.3876, 4.0)  # kappa, q, beta, lambda, p: Curve::Iron
 
 
 def psi(M):
@@ -180,13 +181,15 @@ def ratios(cells, keys, par, applied=False):
 BLEND_NAME = [""]
 
 
-def fit_blend(cells, train, chain_train):
-    """kappa, q, lambda, p on the pair training half (three Nelder-Mead starts; lambda in
-    (0, 1) and p > 1 through their logistic and exp), then beta on the 3- and 4-chains."""
+def fit_blend(cells, train, chain_train, p_fixed=None):
+    """kappa, q, lambda (and p unless p_fixed) on the pair training half (three Nelder-Mead
+    starts; lambda in (0, 1) and p > 1 through their logistic and exp), then beta on the 3- and
+    4-chains."""
     global WIDEN
 
     def unpack(x):
-        return math.exp(x[0]), x[1], 1.0 / (1.0 + math.exp(-x[2])), 1.0 + math.exp(x[3])
+        p = p_fixed if p_fixed is not None else 1.0 + math.exp(x[3])
+        return math.exp(x[0]), x[1], 1.0 / (1.0 + math.exp(-x[2])), p
 
     def loss(x):
         global WIDEN
@@ -199,6 +202,8 @@ def fit_blend(cells, train, chain_train):
         except RuntimeError:  # no stationary magnetization found at this trial point
             return 1e9
     starts = ([math.log(0.59), 1.3, 0.0, 0.0], [math.log(0.74), 1.5, 1.0, 1.0], [math.log(0.4), 1.2, -1.0, -1.0])
+    if p_fixed is not None:
+        starts = tuple(x0[:3] for x0 in starts)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         best = min((minimize(loss, x0, method="Nelder-Mead", options={"xatol": 1e-3, "fatol": 1e-5, "maxiter": 400})
@@ -226,7 +231,8 @@ def main(argv=None):
                     help="the balls' curve: tanh (the engine's eq. 10) or sphere (the reference's bulk iron)")
     ap.add_argument("--widen", choices=("sum", "blend"), default="sum",
                     help="the widened gap: sum (g_e + kappa h^q, eq. 10's balls) or blend (lambda and p "
-                         "fitted too; the engine's iron balls)")
+                         "fitted too, p = 4 as in the engine; the engine's iron balls)")
+    ap.add_argument("--fit-p", action="store_true", help="with --widen blend: fit the exponent p too")
     args = ap.parse_args(argv)
     global CURVE, WIDEN
     CURVE = args.curve
@@ -244,7 +250,7 @@ def main(argv=None):
         WIDEN = widen_blend(*ENGINE_BLEND[3:])
         BLEND_NAME[0] = f", lambda {ENGINE_BLEND[3]:.4g}, p {ENGINE_BLEND[4]:.4g}"
         if not args.no_fit:
-            par = fit_blend(cells, train, chain_train)
+            par = fit_blend(cells, train, chain_train, None if args.fit_p else 4.0)
     elif not args.no_fit:
         def loss(x):  # beta does not enter a lone pair (nu = 1)
             return 1e9 if not 0.3 < x[1] < 3 else wt.ssq(ratios(cells, train, (math.exp(x[0]), x[1], 0.4)))
