@@ -178,13 +178,21 @@ def ratios(cells, keys, par, applied=False):
     return out
 
 
-BLEND_NAME = [""]
+def fit_beta(cells, chain_train, kappa, q):
+    """beta from 0, 0.1, ..., 1 by the 3- and 4-chains' end balls and moments; a beta at which a
+    chain has no stationary magnetization is skipped."""
+    def chain_loss(b):
+        try:
+            return wt.ssq(ratios(cells, chain_train, (kappa, q, b)), ("end", "moment"))
+        except RuntimeError:
+            return math.inf
+    return min((chain_loss(b), b) for b in np.arange(0.0, 1.01, 0.1))[1]
 
 
 def fit_blend(cells, train, chain_train, p_fixed=None):
     """kappa, q, lambda (and p unless p_fixed) on the pair training half (three Nelder-Mead
     starts; lambda in (0, 1) and p > 1 through their logistic and exp), then beta on the 3- and
-    4-chains."""
+    4-chains: ((kappa, q, beta), (lambda, p))."""
     global WIDEN
 
     def unpack(x):
@@ -210,16 +218,10 @@ def fit_blend(cells, train, chain_train, p_fixed=None):
                     for x0 in starts), key=lambda res: res.fun)
     kappa, q, lam, p = unpack(best.x)
     WIDEN = widen_blend(lam, p)
-    def chain_loss(b):
-        try:
-            return wt.ssq(ratios(cells, chain_train, (kappa, q, b)), ("end", "moment"))
-        except RuntimeError:
-            return math.inf
-    beta = min((chain_loss(b), b) for b in np.arange(0.0, 1.01, 0.1))[1]
-    BLEND_NAME[0] = f", lambda {lam:.4g}, p {p:.4g}"
+    beta = fit_beta(cells, chain_train, kappa, q)
     print(f"fitted: kappa {kappa:.4g}, q {q:.4g}, lambda {lam:.4g}, p {p:.4g} (pair training half), beta {beta:.1f} "
           f"(3- and 4-chains at 0.003a); the engine's iron has {ENGINE_BLEND}")
-    return (kappa, q, beta)
+    return (kappa, q, beta), (lam, p)
 
 
 def main(argv=None):
@@ -230,8 +232,8 @@ def main(argv=None):
     ap.add_argument("--curve", choices=("tanh", "sphere"), default="tanh",
                     help="the balls' curve: tanh (the engine's eq. 10) or sphere (the reference's bulk iron)")
     ap.add_argument("--widen", choices=("sum", "blend"), default="sum",
-                    help="the widened gap: sum (g_e + kappa h^q, eq. 10's balls) or blend (lambda and p "
-                         "fitted too, p = 4 as in the engine; the engine's iron balls)")
+                    help="the widened gap: sum (g_e + kappa h^q, eq. 10's balls) or blend (lambda fitted "
+                         "too, p = 4 as in the engine; the engine's iron balls)")
     ap.add_argument("--fit-p", action="store_true", help="with --widen blend: fit the exponent p too")
     args = ap.parse_args(argv)
     global CURVE, WIDEN
@@ -244,25 +246,23 @@ def main(argv=None):
     train = [k for k in pairs if (gaps.index(k[1]) + fields.index(k[2])) % 2 == 0]
     chains = sorted(k for k in cells if k[0] > 2)
     chain_train = [c for c in chains if c[1] == 0.003 and c[0] in (3, 4)]
-    par = ENGINE
+    par, blend_name = ENGINE, ""
     if args.widen == "blend":
-        par = ENGINE_BLEND[:3]
-        WIDEN = widen_blend(*ENGINE_BLEND[3:])
-        BLEND_NAME[0] = f", lambda {ENGINE_BLEND[3]:.4g}, p {ENGINE_BLEND[4]:.4g}"
+        par, lam_p = ENGINE_BLEND[:3], ENGINE_BLEND[3:]
+        WIDEN = widen_blend(*lam_p)
         if not args.no_fit:
-            par = fit_blend(cells, train, chain_train, None if args.fit_p else 4.0)
+            par, lam_p = fit_blend(cells, train, chain_train, None if args.fit_p else 4.0)
+        blend_name = f", lambda {lam_p[0]:.4g}, p {lam_p[1]:.4g}"
     elif not args.no_fit:
         def loss(x):  # beta does not enter a lone pair (nu = 1)
             return 1e9 if not 0.3 < x[1] < 3 else wt.ssq(ratios(cells, train, (math.exp(x[0]), x[1], 0.4)))
         best = min((minimize(loss, x0, method="Nelder-Mead", options={"xatol": 1e-3, "fatol": 1e-5, "maxiter": 200})
                     for x0 in ([math.log(0.553), 1.22], [math.log(0.3), 1.0])), key=lambda res: res.fun)
         kappa, q = math.exp(best.x[0]), best.x[1]
-        grid = [(wt.ssq(ratios(cells, chain_train, (kappa, q, b)), ("end", "moment")), b)
-                for b in np.arange(0.0, 1.01, 0.1)]
-        par = (kappa, q, min(grid)[1])
+        par = (kappa, q, fit_beta(cells, chain_train, kappa, q))
         print(f"fitted: kappa {par[0]:.4g}, q {par[1]:.4g} (pair training half), beta {par[2]:.1f} "
               f"(3- and 4-chains at 0.003a); the engine has {ENGINE}")
-    name = f"flux (kappa {par[0]:.4g}, q {par[1]:.4g}, beta {par[2]:.1f}{BLEND_NAME[0]})"
+    name = f"flux (kappa {par[0]:.4g}, q {par[1]:.4g}, beta {par[2]:.1f}{blend_name})"
     wt.print_pairs(name, ratios(cells, pairs, par), gaps, fields, train)
     wt.print_chains(name + "; training: N = 3, 4 at 0.003a", ratios(cells, chains, par), chains)
     wt.print_chains("candidate C (h = H0/Ms)", ratios(cells, chains, CANDIDATE_C, applied=True), chains)
